@@ -1,0 +1,20 @@
+"""engine: a fast, validated N-body particle engine for games (numba core, plain floats).
+
+    import engine
+    from engine import Simulation, forces, analytic
+
+    sim = Simulation(dim=2, integrator="symplectic_euler", dt=1.0)
+    i = sim.add(mass=1.0, pos=(0.0, 0.0), vel=(2.0, 4.0))
+    sim.add_force(forces.UniformGravity(g=(0.0, -1.0)))
+    sim.step(7)
+"""
+from . import analytic, clock, diagnostics, forces
+from .clock import FixedStepClock
+from .errors import SimulationError
+from .integrators import INTEGRATORS, ORDERS, SYMPLECTIC
+from .simulation import Simulation
+
+__version__ = "0.1.0"
+
+__all__ = ["Simulation", "SimulationError", "INTEGRATORS", "ORDERS", "SYMPLECTIC", "forces",
+           "analytic", "clock", "diagnostics", "FixedStepClock", "__version__"]

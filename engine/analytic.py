@@ -1,0 +1,665 @@
+"""Closed-form solutions used as exact references and as cheap predictors.
+
+Three systems have exact solutions that a game (or a bot predicting the
+future) can evaluate at any time without stepping an integrator:
+
+* :func:`ballistic` -- motion under a constant acceleration,
+* :func:`kepler` -- two-body motion about a fixed centre, for every conic,
+* :func:`harmonic_oscillator` -- the (optionally damped) linear oscillator,
+
+plus :func:`orbital_elements`, a summary of the conic a state lies on.
+
+Layout
+------
+Each public function validates its input (raising :class:`ValueError` that
+names the offending argument) and then calls a numba ``@njit`` core that works
+on plain floats and float64 arrays.  The cores are exported so that other
+compiled code -- a game's step function, a compiled bot -- can call them
+directly.  They do *no* validation: feed them finite values, ``mu > 0`` and a
+non-zero ``r0``, or expect non-finite results.  They are compiled with
+``error_model="numpy"`` so that a degenerate case (a radial orbit evaluated
+exactly at the collision) yields ``inf``/``nan`` instead of raising inside a
+compiled game loop.
+
+Compiled cores
+--------------
+``stumpff(z) -> (c0, c1, c2, c3)``
+``universal_anomaly(r0n, sigma0, alpha, tau) -> chi``
+``lagrange_coefficients(r0, v0, mu, t) -> (f, g, fdot, gdot)``
+``kepler_step(r0, v0, mu, t, r_out, v_out) -> None``  (in place; aliasing ok)
+``kepler_propagate(r0, v0, mu, t) -> (r, v)``
+``kepler_propagate_times(r0, v0, mu, times) -> (R, V)``  (shape (n, dim))
+``orbit_invariants(r0, v0, mu) -> (a, e, energy, period, h, p, periapsis)``
+``oscillator_transition(omega, zeta, t) -> (a, b, c, d)``
+``ballistic_step(p0, v0, g, t, p_out, v_out) -> None``
+
+References
+----------
+* R. R. Bate, D. D. Mueller, J. E. White, *Fundamentals of Astrodynamics*,
+  Dover 1971, ch. 4 (universal variable, f and g functions).
+* D. A. Vallado, *Fundamentals of Astrodynamics and Applications*, 4th ed.
+  2013, sec. 2.3 and algorithm 8 (KEPLER, initial guesses for chi).
+* R. H. Battin, *An Introduction to the Mathematics and Methods of
+  Astrodynamics*, rev. ed., AIAA 1999, sec. 4.5 (universal functions U0..U3,
+  the form of Kepler's equation used here).
+* W. H. Press et al., *Numerical Recipes*, 3rd ed. 2007, sec. 9.4
+  (Newton-Raphson safeguarded by bisection).
+* Any ODE text for the damped oscillator, e.g. A. P. French,
+  *Vibrations and Waves*, 1971, ch. 4.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import namedtuple
+
+import numpy as np
+from numba import njit
+
+__all__ = [
+    # public, validating API
+    "ballistic",
+    "kepler",
+    "harmonic_oscillator",
+    "orbital_elements",
+    "OrbitalElements",
+    # compiled cores
+    "stumpff",
+    "universal_anomaly",
+    "lagrange_coefficients",
+    "kepler_step",
+    "kepler_propagate",
+    "kepler_propagate_times",
+    "orbit_invariants",
+    "oscillator_transition",
+    "ballistic_step",
+]
+
+_TWO_PI = 2.0 * math.pi
+
+# Below this |z| the closed forms of c2, c3 lose digits to cancellation
+# (x - sin x ~ x^3/6), so the Taylor series is used instead.  At |z| = 1 the
+# closed form has lost fewer than 3 bits, and 12 series terms reach 1e-20.
+_SERIES_Z = 1.0
+_SERIES_TERMS = 12
+
+# Relative step size at which Newton iteration on chi is considered converged.
+# Newton converges quadratically, so a step this small leaves an error far
+# below one ulp.
+_CHI_RTOL = 1e-15
+_MAX_ITER = 300
+
+
+# ---------------------------------------------------------------------------
+# Compiled cores
+# ---------------------------------------------------------------------------
+
+
+@njit(cache=True, error_model="numpy")
+def stumpff(z):
+    """Stumpff functions c0(z), c1(z), c2(z), c3(z).
+
+    ``c_k(z) = sum_j (-z)^j / (2j + k)!``; in closed form for ``z > 0``
+    (``x = sqrt(z)``): ``c0 = cos x``, ``c1 = sin x / x``,
+    ``c2 = (1 - cos x) / z``, ``c3 = (x - sin x) / x^3``, and the hyperbolic
+    counterparts for ``z < 0`` (Bate, Mueller & White 1971, sec. 4.3;
+    Vallado 2013, sec. 2.2).
+
+    For ``|z| < 1`` the series is summed, because the closed forms of c2 and
+    c3 cancel catastrophically near z = 0.  ``c2`` uses the half-angle form
+    ``2 sin^2(x/2) / z``, which never cancels.  For very negative ``z`` the
+    hyperbolic values overflow to ``inf``; callers treat that as "too far".
+    """
+    if abs(z) < _SERIES_Z:
+        term2 = 0.5
+        term3 = 1.0 / 6.0
+        c2 = term2
+        c3 = term3
+        for k in range(1, _SERIES_TERMS):
+            term2 *= -z / ((2 * k + 1) * (2 * k + 2))
+            term3 *= -z / ((2 * k + 2) * (2 * k + 3))
+            c2 += term2
+            c3 += term3
+        # |z c2| <= 0.5 and |z c3| <= 0.17 here, so these do not cancel.
+        return 1.0 - z * c2, 1.0 - z * c3, c2, c3
+    if z > 0.0:
+        x = math.sqrt(z)
+        s = math.sin(x)
+        h = math.sin(0.5 * x)
+        # c0 and c1 straight from cos/sin: 1 - z*c3 would cancel near x = pi.
+        return math.cos(x), s / x, 2.0 * h * h / z, (x - s) / (z * x)
+    x = math.sqrt(-z)
+    sh = math.sinh(x)
+    hh = math.sinh(0.5 * x)
+    return math.cosh(x), sh / x, 2.0 * hh * hh / (-z), (sh - x) / (-z * x)
+
+
+@njit(cache=True, error_model="numpy")
+def _universal_functions(chi, alpha):
+    """Battin's U0..U3 for universal anomaly ``chi`` and ``alpha = 1/a``."""
+    chi2 = chi * chi
+    c0, c1, c2, c3 = stumpff(alpha * chi2)
+    return c0, chi * c1, chi2 * c2, chi2 * chi * c3
+
+
+@njit(cache=True, error_model="numpy")
+def universal_anomaly(r0n, sigma0, alpha, tau):
+    """Solve the universal Kepler equation for the universal anomaly chi.
+
+    Solves ``tau = r0n U1(chi) + sigma0 U2(chi) + U3(chi)`` (Battin 1999,
+    eq. 4.84), where ``tau = sqrt(mu) t``, ``sigma0 = (r0 . v0) / sqrt(mu)``,
+    ``alpha = 2/r0n - v0^2/mu`` and U_k are Battin's universal functions.
+    The right-hand side is monotonic in chi with derivative ``r(chi) =
+    r0n U0 + sigma0 U1 + U2 >= 0``, so the root is unique and is found by
+    Newton's method kept inside a bracket: whenever the Newton step leaves
+    the bracket or fails to halve it fast enough, a bisection step is taken
+    instead (Press et al. 2007, sec. 9.4, "rtsafe").  This always converges,
+    including for nearly parabolic and radial orbits.
+
+    For elliptic orbits ``tau`` should already be reduced to within half a
+    period (``lagrange_coefficients`` does this); ``chi`` then lies within
+    one period ``2 pi / sqrt(alpha)`` which bounds the bracket.
+
+    Initial guesses follow Vallado (2013, algorithm 8): ``alpha tau`` for
+    ellipses (exact for circles) and the logarithmic estimate for
+    hyperbolae, with ``min(tau / r0n, cbrt(6 tau))`` as the fallback.
+    """
+    if tau == 0.0:
+        return 0.0
+    # Time symmetry: going back by |tau| is going forward with the velocity
+    # reversed (sigma0 -> -sigma0, chi -> -chi), so only chi >= 0 is solved.
+    d = 1.0 if tau > 0.0 else -1.0
+    target = abs(tau)
+    sig = d * sigma0
+
+    lo = 0.0
+    if alpha > 0.0:
+        hi = _TWO_PI / math.sqrt(alpha)  # one full period: tau(hi) = 2pi/alpha^1.5
+        y = target * alpha
+        if not (y < hi):
+            y = 0.5 * hi
+    else:
+        hi = np.inf
+        y = min(target / r0n, np.cbrt(6.0 * target))
+        if alpha < 0.0:
+            sqa = math.sqrt(-1.0 / alpha)
+            den = sig + sqa * (1.0 - r0n * alpha)
+            arg = -2.0 * alpha * target / den
+            if den > 0.0 and arg > 1.0 and arg < np.inf:
+                y = sqa * math.log(arg)
+        if not (y > 0.0):
+            y = target / r0n
+    if not (y > 0.0):
+        # target so small that chi underflows: the state does not move.
+        return 0.0
+
+    u0, u1, u2, u3 = _universal_functions(y, alpha)
+    G = r0n * u1 + sig * u2 + u3 - target
+    r = r0n * u0 + sig * u1 + u2
+    if G == 0.0:
+        return d * y
+    if G < 0.0:
+        lo = y
+    else:  # positive, or nan from overflow far beyond the root
+        hi = y
+
+    if hi == np.inf:
+        # Unbounded orbit and the guess fell short: double until we pass the
+        # root (tau grows at least cubically in chi here, so this is short).
+        for _ in range(2100):
+            y = 2.0 * y
+            u0, u1, u2, u3 = _universal_functions(y, alpha)
+            G = r0n * u1 + sig * u2 + u3 - target
+            r = r0n * u0 + sig * u1 + u2
+            if G < 0.0:
+                lo = y
+            else:
+                hi = y
+                break
+
+    dx_old = hi - lo
+    dx = dx_old
+    for _ in range(_MAX_ITER):
+        newton_ok = r > 0.0 and abs(G) < np.inf
+        yn = y
+        if newton_ok:
+            yn = y - G / r
+        if (not newton_ok) or (not (lo < yn < hi)) or abs(2.0 * G) > abs(dx_old * r):
+            dx_old = dx
+            dx = 0.5 * (hi - lo)
+            yn = lo + dx
+        else:
+            dx_old = dx
+            dx = yn - y
+        if yn == y or abs(dx) <= _CHI_RTOL * abs(yn):
+            y = yn
+            break
+        y = yn
+        u0, u1, u2, u3 = _universal_functions(y, alpha)
+        G = r0n * u1 + sig * u2 + u3 - target
+        r = r0n * u0 + sig * u1 + u2
+        if G < 0.0:
+            lo = y
+        elif G == 0.0:
+            break
+        else:
+            hi = y
+        if hi - lo <= 2.3e-16 * hi:
+            break
+    return d * y
+
+
+@njit(cache=True, error_model="numpy")
+def lagrange_coefficients(r0, v0, mu, t):
+    """Lagrange f, g, fdot, gdot mapping (r0, v0) to the state at time t.
+
+    ``r = f r0 + g v0`` and ``v = fdot r0 + gdot v0`` with (Battin 1999,
+    sec. 4.5; Bate, Mueller & White 1971, sec. 4.4)::
+
+        f    = 1 - U2 / r0
+        g    = (r0 U1 + sigma0 U2) / sqrt(mu)
+        fdot = -sqrt(mu) U1 / (r r0)
+        gdot = 1 - U2 / r
+        r    = r0 U0 + sigma0 U1 + U2
+
+    ``g`` is written in the cancellation-free form rather than the textbook
+    ``t - U3 / sqrt(mu)``, which loses all digits for short arcs.  For
+    elliptic orbits ``t`` is first reduced to within half a period (the
+    motion is exactly periodic), so arbitrarily long times keep full
+    precision relative to ``t`` itself.
+
+    ``r0`` and ``v0`` are float arrays of equal length (2 or 3), ``mu > 0``.
+    """
+    n = r0.shape[0]
+    r0n2 = 0.0
+    v02 = 0.0
+    rv = 0.0
+    for i in range(n):
+        r0n2 += r0[i] * r0[i]
+        v02 += v0[i] * v0[i]
+        rv += r0[i] * v0[i]
+    r0n = math.sqrt(r0n2)
+    sqmu = math.sqrt(mu)
+    sigma0 = rv / sqmu
+    alpha = 2.0 / r0n - v02 / mu
+
+    if alpha > 0.0:
+        period = _TWO_PI / (sqmu * alpha * math.sqrt(alpha))
+        if abs(t) > 0.5 * period:
+            # np.fmod is exact, so the only error left is that of t itself.
+            t = np.fmod(t, period)
+            if t > 0.5 * period:
+                t -= period
+            elif t < -0.5 * period:
+                t += period
+    chi = universal_anomaly(r0n, sigma0, alpha, sqmu * t)
+    u0, u1, u2, u3 = _universal_functions(chi, alpha)
+    r = r0n * u0 + sigma0 * u1 + u2
+    f = 1.0 - u2 / r0n
+    g = (r0n * u1 + sigma0 * u2) / sqmu
+    fdot = -sqmu * u1 / (r * r0n)
+    gdot = 1.0 - u2 / r
+    return f, g, fdot, gdot
+
+
+@njit(cache=True, error_model="numpy")
+def kepler_step(r0, v0, mu, t, r_out, v_out):
+    """Advance a Kepler state by ``t`` and write it to ``r_out``, ``v_out``.
+
+    Same physics as :func:`kepler`; no validation.  ``r_out``/``v_out`` may be
+    the very arrays ``r0``/``v0`` (in-place update for a game loop).
+    """
+    f, g, fdot, gdot = lagrange_coefficients(r0, v0, mu, t)
+    for i in range(r0.shape[0]):
+        # Read both components before writing, so aliasing is safe.
+        ri = r0[i]
+        vi = v0[i]
+        r_out[i] = f * ri + g * vi
+        v_out[i] = fdot * ri + gdot * vi
+
+
+@njit(cache=True, error_model="numpy")
+def kepler_propagate(r0, v0, mu, t):
+    """Compiled ``kepler`` for a scalar time: returns new arrays ``(r, v)``."""
+    r = np.empty(r0.shape[0])
+    v = np.empty(r0.shape[0])
+    kepler_step(r0, v0, mu, t, r, v)
+    return r, v
+
+
+@njit(cache=True, error_model="numpy")
+def kepler_propagate_times(r0, v0, mu, times):
+    """Compiled ``kepler`` for many times: arrays ``(R, V)`` of shape (n, dim).
+
+    Every row is propagated from the initial state (not chained), so errors
+    do not accumulate along the array.
+    """
+    nt = times.shape[0]
+    dim = r0.shape[0]
+    R = np.empty((nt, dim))
+    V = np.empty((nt, dim))
+    for k in range(nt):
+        kepler_step(r0, v0, mu, times[k], R[k], V[k])
+    return R, V
+
+
+@njit(cache=True, error_model="numpy")
+def orbit_invariants(r0, v0, mu):
+    """Conic invariants ``(a, e, energy, period, h, p, periapsis)``.
+
+    ``energy = v^2/2 - mu/r``, ``a = -mu / (2 energy)`` (``inf`` for a
+    parabola, negative for a hyperbola), ``h = |r x v|``, semi-latus rectum
+    ``p = h^2/mu``, eccentricity from the Laplace-Runge-Lenz vector
+    ``e = ((v^2 - mu/r) r - (r.v) v) / mu``, periapsis distance
+    ``q = p / (1 + e)``, and ``period = 2 pi sqrt(a^3/mu)`` for bound orbits
+    (``inf`` otherwise).  Bate, Mueller & White 1971, ch. 1 and 2.
+    """
+    n = r0.shape[0]
+    rr = 0.0
+    vv = 0.0
+    rv = 0.0
+    for i in range(n):
+        rr += r0[i] * r0[i]
+        vv += v0[i] * v0[i]
+        rv += r0[i] * v0[i]
+    rn = math.sqrt(rr)
+    energy = 0.5 * vv - mu / rn
+    if n == 3:
+        hx = r0[1] * v0[2] - r0[2] * v0[1]
+        hy = r0[2] * v0[0] - r0[0] * v0[2]
+        hz = r0[0] * v0[1] - r0[1] * v0[0]
+        h = math.sqrt(hx * hx + hy * hy + hz * hz)
+    else:
+        h = abs(r0[0] * v0[1] - r0[1] * v0[0])
+    k = vv - mu / rn
+    e2 = 0.0
+    for i in range(n):
+        ei = (k * r0[i] - rv * v0[i]) / mu
+        e2 += ei * ei
+    e = math.sqrt(e2)
+    p = h * h / mu
+    if energy != 0.0:
+        a = -mu / (2.0 * energy)
+    else:
+        a = np.inf
+    if energy < 0.0:
+        period = _TWO_PI * math.sqrt(a * a * a / mu)
+    else:
+        period = np.inf
+    return a, e, energy, period, h, p, p / (1.0 + e)
+
+
+@njit(cache=True, error_model="numpy")
+def oscillator_transition(omega, zeta, t):
+    """State-transition coefficients of ``x'' + 2 zeta omega x' + omega^2 x = 0``.
+
+    Returns ``(a, b, c, d)`` with ``x(t) = a x0 + b v0`` and
+    ``v(t) = c x0 + d v0``.  One formula covers every regime (French 1971,
+    ch. 4, written in Stumpff functions)::
+
+        x = E (x0 C + (v0 + zeta omega x0) S)
+        v = E (v0 C - (omega^2 x0 + zeta omega v0) S)
+        E = exp(-zeta omega t),  q = omega^2 (1 - zeta^2) t^2,
+        C = c0(q) = cos(omega_d t)       or cosh(gamma t),
+        S = t c1(q) = sin(omega_d t)/omega_d or sinh(gamma t)/gamma
+
+    with ``omega_d = omega sqrt(1 - zeta^2)`` and ``gamma = omega
+    sqrt(zeta^2 - 1)``.  The Stumpff form is continuous through critical
+    damping (``C -> 1``, ``S -> t``) without 0/0.  For strongly overdamped
+    motion (``gamma |t| > 1``) the exponentials are combined first,
+    ``E C = (e^{s1 t} + e^{s2 t}) / 2``, ``E S = (e^{s1 t} - e^{s2 t}) /
+    (2 gamma)`` with roots ``s1 = -omega / (zeta + sqrt(zeta^2 - 1))``,
+    ``s2 = -omega (zeta + sqrt(zeta^2 - 1))``, because ``exp(-zeta omega t)``
+    underflows while ``cosh(gamma t)`` overflows.
+    """
+    zw = zeta * omega
+    if zeta > 1.0:
+        root = math.sqrt((zeta - 1.0) * (zeta + 1.0))
+        gamma = omega * root
+        if gamma * abs(t) > 1.0:
+            s1 = -omega / (zeta + root)  # slow root, written without cancellation
+            s2 = -omega * (zeta + root)
+            e1 = math.exp(s1 * t)
+            e2 = math.exp(s2 * t)
+            EC = 0.5 * (e1 + e2)
+            ES = 0.5 * (e1 - e2) / gamma
+            return EC + zw * ES, ES, -omega * omega * ES, EC - zw * ES
+    # (1 - zeta)(1 + zeta) keeps its digits near critical damping.
+    q = omega * omega * (1.0 - zeta) * (1.0 + zeta) * t * t
+    c0, c1, c2, c3 = stumpff(q)
+    E = math.exp(-zw * t)
+    EC = E * c0
+    ES = E * t * c1
+    return EC + zw * ES, ES, -omega * omega * ES, EC - zw * ES
+
+
+@njit(cache=True, error_model="numpy")
+def ballistic_step(p0, v0, g, t, p_out, v_out):
+    """Compiled ``ballistic`` for one time; ``p_out``/``v_out`` may alias inputs."""
+    half_tt = 0.5 * t * t
+    for i in range(p0.shape[0]):
+        pi = p0[i]
+        vi = v0[i]
+        gi = g[i]
+        p_out[i] = pi + vi * t + gi * half_tt
+        v_out[i] = vi + gi * t
+
+
+# ---------------------------------------------------------------------------
+# Validation helpers
+# ---------------------------------------------------------------------------
+
+
+def _real_array(name, value):
+    """``value`` as a float64 array; ValueError naming ``name`` otherwise."""
+    try:
+        raw = np.asarray(value)
+    except Exception as exc:  # ragged lists and the like
+        raise ValueError(f"{name} must be a real number or array, got {value!r}") from exc
+    # Strings and complex numbers would otherwise be coerced or fail obscurely.
+    if raw.dtype.kind not in "biuf":
+        raise ValueError(f"{name} must be a real number or array, got {value!r}")
+    arr = raw.astype(np.float64)
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"{name} must be finite, got {value!r}")
+    return arr
+
+
+def _real_scalar(name, value):
+    arr = _real_array(name, value)
+    if arr.ndim != 0:
+        raise ValueError(f"{name} must be a scalar, got {value!r}")
+    return float(arr)
+
+
+def _state_vector(name, value):
+    arr = _real_array(name, value)
+    if arr.ndim != 1 or arr.shape[0] not in (2, 3):
+        raise ValueError(f"{name} must be a vector of length 2 or 3, got {value!r}")
+    return np.ascontiguousarray(arr)
+
+
+def _times(name, value):
+    """Returns ``(array, is_scalar)``; ``array`` is 0-d or 1-D float64."""
+    arr = _real_array(name, value)
+    if arr.ndim > 1:
+        raise ValueError(f"{name} must be a scalar or a 1-D array of times, got {value!r}")
+    # (np.ascontiguousarray would promote a 0-d array to 1-D.)
+    return np.require(arr, requirements="C"), arr.ndim == 0
+
+
+def _kepler_inputs(r0, v0, mu):
+    r0a = _state_vector("r0", r0)
+    v0a = _state_vector("v0", v0)
+    if v0a.shape != r0a.shape:
+        raise ValueError(f"v0 must have the same length as r0 ({r0a.shape[0]}), got {v0!r}")
+    mu_f = _real_scalar("mu", mu)
+    if not mu_f > 0.0:
+        raise ValueError(f"mu must be positive, got {mu!r}")
+    if not np.any(r0a != 0.0):
+        raise ValueError(f"r0 must have non-zero length, got {r0!r}")
+    return r0a, v0a, mu_f
+
+
+# ---------------------------------------------------------------------------
+# Public API
+# ---------------------------------------------------------------------------
+
+
+def ballistic(p0, v0, g, t):
+    """Motion under constant acceleration.
+
+    ``p = p0 + v0 t + g t^2 / 2``, ``v = v0 + g t`` (uniformly accelerated
+    motion; Galileo, any mechanics text).
+
+    ``p0``, ``v0``, ``g`` are scalars or arrays of any dimension that
+    broadcast together (e.g. one ``(dim,)`` gravity for an ``(n, dim)`` batch
+    of particles).  ``t`` is a scalar, giving arrays of the broadcast shape,
+    or a 1-D array of times, giving arrays with a leading time axis
+    ``(len(t),) + shape`` -- handy for drawing a predicted path.
+
+    Raises ValueError, naming the argument, for non-finite or non-real
+    input, shapes that do not broadcast, or ``t`` with more than one axis.
+    """
+    p0a = _real_array("p0", p0)
+    v0a = _real_array("v0", v0)
+    ga = _real_array("g", g)
+    ta, _ = _times("t", t)
+    try:
+        shape = np.broadcast_shapes(p0a.shape, v0a.shape, ga.shape)
+    except ValueError as exc:
+        raise ValueError(
+            f"p0, v0 and g must have compatible shapes, got p0 {p0a.shape}, "
+            f"v0 {v0a.shape}, g {ga.shape}"
+        ) from exc
+    tt = ta.reshape(ta.shape + (1,) * len(shape))
+    p = p0a + v0a * tt + 0.5 * ga * (tt * tt)
+    v = v0a + ga * tt
+    out_shape = ta.shape + shape
+    return np.broadcast_to(p, out_shape).copy(), np.broadcast_to(v, out_shape).copy()
+
+
+def kepler(r0, v0, mu, t):
+    """Two-body motion about a fixed centre, for any conic section.
+
+    Solves ``r'' = -mu r / |r|^3`` exactly for the relative position ``r0``
+    and velocity ``v0`` (vectors of length 2 or 3) after time ``t``, which may
+    be negative (backwards) or a 1-D array of times.
+
+    Method: universal variables (Bate, Mueller & White 1971, ch. 4; Battin
+    1999, sec. 4.5; Vallado 2013, algorithm 8).  With
+    ``alpha = 2/|r0| - |v0|^2/mu`` and ``sigma0 = r0.v0 / sqrt(mu)`` the
+    universal Kepler equation::
+
+        sqrt(mu) t = |r0| U1(chi) + sigma0 U2(chi) + U3(chi)
+
+    is solved for chi by bracketed Newton iteration (see
+    :func:`universal_anomaly`), and the state follows from the Lagrange
+    coefficients (see :func:`lagrange_coefficients`).  Elliptic, circular,
+    parabolic and hyperbolic orbits use the same formulas; elliptic times are
+    first reduced modulo the period, so millions of orbits stay accurate.
+
+    Radial orbits (``r0`` parallel to ``v0``) are supported; a bound radial
+    orbit is continued through the collision as the regularised elastic
+    bounce, and exactly at the collision instant the velocity is infinite.
+
+    Returns ``(r, v)`` as arrays of shape ``(dim,)``, or ``(len(t), dim)``
+    for an array of times.  The compiled core is :func:`kepler_propagate`
+    (and :func:`kepler_step` for in-place updates).
+
+    Raises ValueError naming the argument for: non-finite or non-real
+    entries; ``r0``/``v0`` not of length 2 or 3 or of different lengths;
+    ``mu <= 0``; ``r0`` of zero length; ``t`` with more than one axis.
+    """
+    r0a, v0a, mu_f = _kepler_inputs(r0, v0, mu)
+    ta, scalar = _times("t", t)
+    if scalar:
+        return kepler_propagate(r0a, v0a, mu_f, float(ta))
+    return kepler_propagate_times(r0a, v0a, mu_f, ta)
+
+
+def harmonic_oscillator(x0, v0, omega, t, zeta=0.0):
+    """Linear oscillator ``x'' + 2 zeta omega x' + omega^2 x = 0``.
+
+    Undamped (``zeta = 0``), under-damped (``0 < zeta < 1``), critically
+    damped (``zeta = 1``) and over-damped (``zeta > 1``) motion from the
+    closed-form solution in :func:`oscillator_transition`; e.g. undamped
+    ``x = x0 cos(omega t) + v0/omega sin(omega t)``, critical
+    ``x = e^{-omega t} (x0 + (v0 + omega x0) t)``.
+
+    ``x0`` and ``v0`` are scalars or arrays that broadcast together (each
+    component oscillates independently with the same ``omega``, ``zeta``);
+    ``t`` is a scalar or a 1-D array of times (leading time axis in the
+    output).  Returns ``(x, v)``.
+
+    Raises ValueError naming the argument for non-finite or non-real input,
+    ``omega <= 0``, ``zeta < 0`` or incompatible shapes.
+    """
+    x0a = _real_array("x0", x0)
+    v0a = _real_array("v0", v0)
+    omega_f = _real_scalar("omega", omega)
+    if not omega_f > 0.0:
+        raise ValueError(f"omega must be positive, got {omega!r}")
+    zeta_f = _real_scalar("zeta", zeta)
+    if zeta_f < 0.0:
+        raise ValueError(f"zeta must be non-negative, got {zeta!r}")
+    ta, scalar = _times("t", t)
+    try:
+        shape = np.broadcast_shapes(x0a.shape, v0a.shape)
+    except ValueError as exc:
+        raise ValueError(
+            f"x0 and v0 must have compatible shapes, got x0 {x0a.shape}, v0 {v0a.shape}"
+        ) from exc
+    flat_t = ta.reshape(-1)
+    nt = flat_t.shape[0]
+    coeffs = np.empty((nt, 4))
+    for k in range(nt):
+        coeffs[k] = oscillator_transition(omega_f, zeta_f, float(flat_t[k]))
+    expand = (slice(None),) + (None,) * len(shape)
+    a, b, c, d = (coeffs[:, j][expand] for j in range(4))
+    x = np.broadcast_to(a * x0a + b * v0a, (nt,) + shape).copy()
+    v = np.broadcast_to(c * x0a + d * v0a, (nt,) + shape).copy()
+    if not scalar:
+        return x, v
+    if shape == ():
+        return float(x[0]), float(v[0])
+    return x[0], v[0]
+
+
+OrbitalElements = namedtuple(
+    "OrbitalElements",
+    ["a", "e", "energy", "period", "h", "p", "periapsis", "e_vec", "h_vec"],
+)
+OrbitalElements.__doc__ = """Invariants of a two-body orbit (see :func:`orbital_elements`).
+
+a         semi-major axis (negative for hyperbolae, inf for a parabola)
+e         eccentricity
+energy    specific orbital energy v^2/2 - mu/r
+period    orbital period, inf for unbound orbits
+h         magnitude of the specific angular momentum |r x v|
+p         semi-latus rectum h^2/mu
+periapsis periapsis distance p / (1 + e)
+e_vec     eccentricity vector (same length as the input, points to periapsis)
+h_vec     angular momentum vector r x v as a 3-vector (z only, for 2-D input)
+"""
+
+
+def orbital_elements(r0, v0, mu):
+    """Summary of the conic through the state ``(r0, v0)`` about ``mu``.
+
+    Returns :class:`OrbitalElements` ``(a, e, energy, period, h, p,
+    periapsis, e_vec, h_vec)``; formulas in :func:`orbit_invariants`
+    (Bate, Mueller & White 1971, ch. 1-2).  Validates like :func:`kepler`.
+    """
+    r0a, v0a, mu_f = _kepler_inputs(r0, v0, mu)
+    a, e, energy, period, h, p, q = orbit_invariants(r0a, v0a, mu_f)
+    r3 = np.zeros(3)
+    v3 = np.zeros(3)
+    r3[: r0a.shape[0]] = r0a
+    v3[: v0a.shape[0]] = v0a
+    h_vec = np.cross(r3, v3)
+    rn = float(np.linalg.norm(r0a))
+    e_vec = ((v0a @ v0a - mu_f / rn) * r0a - (r0a @ v0a) * v0a) / mu_f
+    return OrbitalElements(
+        float(a), float(e), float(energy), float(period), float(h), float(p), float(q), e_vec, h_vec
+    )

@@ -1,0 +1,23 @@
+"""Small numba helpers the force kernels share."""
+from numba import njit
+
+
+@njit(cache=True, inline="always")
+def add_force(acc, i, dim, f0, f1, f2, m):
+    """acc_i += f / m_i, skipping an exact zero force so a massless particle with no force
+    stays finite (a massless particle *with* a force becomes infinite and the step fails)."""
+    if f0 == 0.0 and f1 == 0.0 and f2 == 0.0:
+        return
+    acc[0, i] += f0 / m
+    acc[1, i] += f1 / m
+    if dim == 3:
+        acc[2, i] += f2 / m
+
+
+@njit(cache=True, inline="always")
+def delta(pos, i, j, dim):
+    """The separation p_j - p_i as three floats (z = 0 in 2-D)."""
+    dx = pos[0, j] - pos[0, i]
+    dy = pos[1, j] - pos[1, i]
+    dz = pos[2, j] - pos[2, i] if dim == 3 else 0.0
+    return dx, dy, dz

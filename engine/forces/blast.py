@@ -1,0 +1,73 @@
+"""A blast: a radial push away from a point, falling off with distance, for explosions.
+
+    f_i = s r_hat / (1 + (r / L)^2)     while  t0 <= t < t0 + duration
+
+with r = |p_i - c|, strength s, length scale L (the push halves at r = L and falls off like
+1/r^2 far away), c the centre. A particle exactly at the centre has no outward direction and
+feels nothing. It is a shock, not a field: not conservative. Its impulse is s * duration at
+the centre's edge, so a short, strong blast is an explosion and a long weak one is a wind.
+"""
+import math
+
+import numpy as np
+from numba import njit
+
+from ._kernels import add_force
+from .base import Force, EMPTY_INTS
+from .._validate import finite_float, positive_float, vector
+
+KIND = 9
+
+
+@njit(cache=True)
+def accumulate(t, pos, vel, prm, n, fp, ip, acc):
+    mass = prm[0]
+    active = prm[3]
+    strength, scale, t0, duration = fp[0], fp[1], fp[2], fp[3]
+    if not (t0 <= t < t0 + duration):
+        return
+    dim = pos.shape[0]
+    cz = fp[6] if dim == 3 else 0.0
+    for i in range(n):
+        if not active[i]:
+            continue
+        dx = pos[0, i] - fp[4]
+        dy = pos[1, i] - fp[5]
+        dz = pos[2, i] - cz if dim == 3 else 0.0
+        r = math.sqrt(dx * dx + dy * dy + dz * dz)
+        if r == 0.0:
+            continue
+        q = r / scale
+        s = strength / ((1.0 + q * q) * r)
+        add_force(acc, i, dim, s * dx, s * dy, s * dz, mass[i])
+
+
+@njit(cache=True)
+def potential(t, pos, vel, prm, n, fp, ip):
+    return 0.0
+
+
+class Blast(Force):
+    """Outward push of ``strength`` from ``center`` with length ``scale``, from ``start`` for
+    ``duration`` (simulation time; ``duration=inf`` keeps it on)."""
+
+    KIND = KIND
+
+    def __init__(self, center, strength, scale=1.0, start=0.0, duration=math.inf):
+        super().__init__()
+        self.center = vector("center", center)
+        self.strength = finite_float("strength", strength)
+        self.scale = positive_float("scale", scale)
+        self.start = finite_float("start", start)
+        if isinstance(duration, bool) or not (isinstance(duration, (int, float, np.floating))
+                                              and duration > 0 and not math.isnan(duration)):
+            raise ValueError(f"duration must be > 0 (inf allowed), got {duration!r}")
+        self.duration = float(duration)
+
+    def _check(self, sim):
+        if self.center.shape[0] != sim.dim:
+            raise ValueError(f"Blast center must have length {sim.dim}, got {tuple(self.center)}")
+
+    def _pack(self, sim):
+        head = np.array([self.strength, self.scale, self.start, self.duration])
+        return np.concatenate((head, self.center)), EMPTY_INTS

@@ -1,0 +1,74 @@
+"""Electric force between charged particles (Coulomb's law, Plummer-softened).
+
+f_a = -k q_a q_b (p_b - p_a) / (|p_b - p_a|^2 + eps^2)^(3/2)     (lecture, "electric forces":
+like charges repel)     U = sum_{a<b} k q_a q_b / sqrt(|p_b - p_a|^2 + eps^2)
+
+Pairs act equally and oppositely (momentum conserved to round-off); the acceleration is f / m.
+Uncharged and inactive particles are skipped; test particles do take part (the test flag is
+about gravity only).
+"""
+import math
+
+from numba import njit
+
+from ._kernels import add_force, delta
+from .base import Force, floats, EMPTY_INTS
+from .._validate import nonnegative_float, finite_float
+
+KIND = 3
+
+
+@njit(cache=True)
+def accumulate(t, pos, vel, prm, n, fp, ip, acc):
+    mass, charge, _, active, _ = prm
+    k = fp[0]
+    eps2 = fp[1]
+    dim = pos.shape[0]
+    for i in range(n):
+        if not active[i] or charge[i] == 0.0:
+            continue
+        for j in range(i + 1, n):
+            if not active[j] or charge[j] == 0.0:
+                continue
+            dx, dy, dz = delta(pos, i, j, dim)
+            r2 = dx * dx + dy * dy + dz * dz + eps2
+            s = k * charge[i] * charge[j] / (r2 * math.sqrt(r2))
+            # force on i is -s d (repulsion for s > 0); on j it is +s d
+            add_force(acc, i, dim, -s * dx, -s * dy, -s * dz, mass[i])
+            add_force(acc, j, dim, s * dx, s * dy, s * dz, mass[j])
+
+
+@njit(cache=True)
+def potential(t, pos, vel, prm, n, fp, ip):
+    _, charge, _, active, _ = prm
+    k = fp[0]
+    eps2 = fp[1]
+    dim = pos.shape[0]
+    u = 0.0
+    for i in range(n):
+        if not active[i] or charge[i] == 0.0:
+            continue
+        for j in range(i + 1, n):
+            if not active[j] or charge[j] == 0.0:
+                continue
+            dx, dy, dz = delta(pos, i, j, dim)
+            u += k * charge[i] * charge[j] / math.sqrt(dx * dx + dy * dy + dz * dz + eps2)
+    return u
+
+
+class Coulomb(Force):
+    """Coulomb forces between all charged active particles; ``k`` is the Coulomb constant."""
+
+    KIND = KIND
+    conservative = True
+
+    def __init__(self, k=1.0, softening=0.0):
+        super().__init__()
+        self.k = finite_float("k", k)
+        self.softening = nonnegative_float("softening", softening)
+
+    def _pack(self, sim):
+        return floats(self.k, self.softening ** 2), EMPTY_INTS
+
+    def __repr__(self):
+        return f"Coulomb(k={self.k!r}, softening={self.softening!r})"

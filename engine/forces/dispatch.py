@@ -1,0 +1,86 @@
+"""The compiled force table: one call evaluates every declared term, and only those.
+
+A simulation's terms are packed into ``model = (kinds, fp, foff, ip, ioff)``: term ``s`` has
+kind ``kinds[s]`` and parameters ``fp[foff[s]:foff[s+1]]`` and ``ip[ioff[s]:ioff[s+1]]``. The
+branch per term per evaluation is negligible against the work of the terms themselves, and
+having one signature means every integrator is compiled once and cached, whatever the scene.
+"""
+import numpy as np
+from numba import njit
+
+from . import (blast, buoyancy, coulomb, drag, gravity, point_mass, springs, thrust,
+               uniform_gravity, wind)
+
+
+@njit(cache=True)
+def accelerations(t, pos, vel, prm, n, model, acc):
+    """Overwrite ``acc[:, :n]`` with the total acceleration of every declared term at time t."""
+    kinds, fp_all, foff, ip_all, ioff = model
+    for k in range(acc.shape[0]):
+        for i in range(n):
+            acc[k, i] = 0.0
+    for s in range(kinds.shape[0]):
+        fp = fp_all[foff[s]:foff[s + 1]]
+        ip = ip_all[ioff[s]:ioff[s + 1]]
+        kind = kinds[s]
+        if kind == gravity.KIND:
+            gravity.accumulate(t, pos, vel, prm, n, fp, ip, acc)
+        elif kind == point_mass.KIND:
+            point_mass.accumulate(t, pos, vel, prm, n, fp, ip, acc)
+        elif kind == uniform_gravity.KIND:
+            uniform_gravity.accumulate(t, pos, vel, prm, n, fp, ip, acc)
+        elif kind == coulomb.KIND:
+            coulomb.accumulate(t, pos, vel, prm, n, fp, ip, acc)
+        elif kind == springs.KIND:
+            springs.accumulate(t, pos, vel, prm, n, fp, ip, acc)
+        elif kind == drag.KIND:
+            drag.accumulate(t, pos, vel, prm, n, fp, ip, acc)
+        elif kind == thrust.KIND:
+            thrust.accumulate(t, pos, vel, prm, n, fp, ip, acc)
+        elif kind == wind.KIND:
+            wind.accumulate(t, pos, vel, prm, n, fp, ip, acc)
+        elif kind == buoyancy.KIND:
+            buoyancy.accumulate(t, pos, vel, prm, n, fp, ip, acc)
+        elif kind == blast.KIND:
+            blast.accumulate(t, pos, vel, prm, n, fp, ip, acc)
+
+
+@njit(cache=True)
+def potential_terms(t, pos, vel, prm, n, model, out):
+    """Write each term's potential energy into ``out[s]`` (0 for non-conservative terms)."""
+    kinds, fp_all, foff, ip_all, ioff = model
+    for s in range(kinds.shape[0]):
+        fp = fp_all[foff[s]:foff[s + 1]]
+        ip = ip_all[ioff[s]:ioff[s + 1]]
+        kind = kinds[s]
+        u = 0.0
+        if kind == gravity.KIND:
+            u = gravity.potential(t, pos, vel, prm, n, fp, ip)
+        elif kind == point_mass.KIND:
+            u = point_mass.potential(t, pos, vel, prm, n, fp, ip)
+        elif kind == uniform_gravity.KIND:
+            u = uniform_gravity.potential(t, pos, vel, prm, n, fp, ip)
+        elif kind == coulomb.KIND:
+            u = coulomb.potential(t, pos, vel, prm, n, fp, ip)
+        elif kind == springs.KIND:
+            u = springs.potential(t, pos, vel, prm, n, fp, ip)
+        elif kind == buoyancy.KIND:
+            u = buoyancy.potential(t, pos, vel, prm, n, fp, ip)
+        out[s] = u
+
+
+def pack(terms, sim):
+    """Concatenate the terms' parameters into the model tuple the kernels take."""
+    fps, ips = [], []
+    for term in terms:
+        fp, ip = term._pack(sim)
+        fps.append(np.ascontiguousarray(fp, dtype=np.float64))
+        ips.append(np.ascontiguousarray(ip, dtype=np.int64))
+    kinds = np.array([term.KIND for term in terms], dtype=np.int64)
+    foff = np.zeros(len(terms) + 1, dtype=np.int64)
+    ioff = np.zeros(len(terms) + 1, dtype=np.int64)
+    foff[1:] = np.cumsum([a.shape[0] for a in fps]) if terms else []
+    ioff[1:] = np.cumsum([a.shape[0] for a in ips]) if terms else []
+    fp = np.concatenate(fps) if fps else np.zeros(0)
+    ip = np.concatenate(ips) if ips else np.zeros(0, dtype=np.int64)
+    return kinds, fp, foff, ip, ioff

@@ -1,0 +1,178 @@
+"""Damped Hooke springs between particle pairs (mass-spring ropes, cloth, soft bodies).
+
+For a spring from a to b with d = p_b - p_a, r = |d|, stiffness k, rest length l, damping c:
+
+    f_a = k (r - l) d/r + c ((v_b - v_a) . d/r) d/r,     f_b = -f_a
+
+(the lecture's Hooke's law, plus a dashpot acting along the spring only, so it damps stretching
+but not rigid rotation).     U = sum 1/2 k (r - l)^2  (the damping part is not conservative).
+
+k, l and c may be scalars or one value per spring. A zero-length spring (l = 0) is linear,
+f_a = k d, and is well defined even with a and b coincident; a spring with l > 0 whose ends
+coincide has no direction and makes the step fail loudly.
+"""
+import math
+
+import numpy as np
+from numba import njit
+
+from ._kernels import add_force, delta
+from .base import Force
+from .._validate import per_item, vector, positive_float, nonnegative_float
+
+KIND = 4
+
+
+@njit(cache=True)
+def accumulate(t, pos, vel, prm, n, fp, ip, acc):
+    mass, _, _, active, _ = prm
+    dim = pos.shape[0]
+    m = ip.shape[0] // 2
+    for s in range(m):
+        a = ip[2 * s]
+        b = ip[2 * s + 1]
+        if not (active[a] and active[b]):
+            continue
+        k = fp[s]
+        rest = fp[m + s]
+        c = fp[2 * m + s]
+        dx, dy, dz = delta(pos, a, b, dim)
+        r2 = dx * dx + dy * dy + dz * dz
+        r = math.sqrt(r2)
+        scale = k if rest == 0.0 else k * (1.0 - rest / r)
+        if c != 0.0 and r2 > 0.0:
+            dvx, dvy, dvz = delta(vel, a, b, dim)
+            scale += c * (dvx * dx + dvy * dy + dvz * dz) / r2
+        add_force(acc, a, dim, scale * dx, scale * dy, scale * dz, mass[a])
+        add_force(acc, b, dim, -scale * dx, -scale * dy, -scale * dz, mass[b])
+
+
+@njit(cache=True)
+def potential(t, pos, vel, prm, n, fp, ip):
+    active = prm[3]
+    dim = pos.shape[0]
+    m = ip.shape[0] // 2
+    u = 0.0
+    for s in range(m):
+        a = ip[2 * s]
+        b = ip[2 * s + 1]
+        if not (active[a] and active[b]):
+            continue
+        dx, dy, dz = delta(pos, a, b, dim)
+        stretch = math.sqrt(dx * dx + dy * dy + dz * dz) - fp[m + s]
+        u += 0.5 * fp[s] * stretch * stretch
+    return u
+
+
+class Springs(Force):
+    """Springs between index ``pairs``; ``k``, ``rest_length``, ``damping`` scalar or per spring.
+
+    The indices are checked against the simulation when the term is added.
+    """
+
+    KIND = KIND
+    conservative = True
+
+    def __init__(self, pairs, k=10.0, rest_length=1.0, damping=0.0):
+        super().__init__()
+        try:
+            arr = np.array(pairs, dtype=np.int64)
+        except (TypeError, ValueError, OverflowError):
+            raise TypeError(f"pairs must be a list of (i, j) index pairs, got {pairs!r}") from None
+        if arr.size == 0:
+            arr = arr.reshape(0, 2)
+        if arr.ndim != 2 or arr.shape[1] != 2:
+            raise ValueError(f"pairs must have shape (M, 2), got shape {arr.shape}")
+        if np.any(arr[:, 0] == arr[:, 1]):
+            bad = int(np.flatnonzero(arr[:, 0] == arr[:, 1])[0])
+            raise ValueError(f"pairs[{bad}] joins particle {arr[bad, 0]} to itself")
+        count = arr.shape[0]
+        self.pairs = arr
+        self.k = per_item("k", k, count, minimum=0.0)
+        self.rest_length = per_item("rest_length", rest_length, count, minimum=0.0)
+        self.damping = per_item("damping", damping, count, minimum=0.0)
+
+    def __len__(self):
+        return self.pairs.shape[0]
+
+    @property
+    def velocity_dependent(self):
+        return bool(np.any(self.damping > 0.0))
+
+    def _check(self, sim):
+        bad = (self.pairs < 0) | (self.pairs >= sim.n)
+        if np.any(bad):
+            s, end = np.argwhere(bad)[0]
+            raise ValueError(f"pairs[{s}][{end}] = {self.pairs[s, end]} is out of range "
+                             f"(the simulation has {sim.n} particles)")
+
+    def _pack(self, sim):
+        fp = np.concatenate((self.k, self.rest_length, self.damping))
+        return fp, self.pairs.reshape(-1).copy()
+
+    def __repr__(self):
+        return f"Springs({len(self)} springs)"
+
+
+def rope(sim, start, end, segments, mass, k, damping=0.0, test=False):
+    """Add a rope of ``segments`` springs from ``start`` to ``end`` at rest.
+
+    ``mass`` is the mass of each of the ``segments + 1`` particles. The springs are added to
+    ``sim`` and their rest length is the initial spacing. Returns ``(indices, springs)``.
+    """
+    segments = int(segments)
+    if segments < 1:
+        raise ValueError(f"segments must be >= 1, got {segments!r}")
+    a = vector("start", start, sim.dim)
+    b = vector("end", end, sim.dim)
+    positive_float("mass", mass)
+    nonnegative_float("k", k)
+    nonnegative_float("damping", damping)
+    frac = np.linspace(0.0, 1.0, segments + 1)[:, None]
+    idx = sim.add_many(mass=mass, pos=a + frac * (b - a), test=test)
+    spacing = float(np.linalg.norm(b - a)) / segments
+    springs = Springs(np.column_stack((idx[:-1], idx[1:])), k=k, rest_length=spacing,
+                      damping=damping)
+    sim.add_force(springs)
+    return idx, springs
+
+
+def cloth(sim, corner, edge_u, edge_v, nu, nv, mass, k, damping=0.0, shear=True, bend=False):
+    """Add a cloth grid of ``nu x nv`` particles spanning ``corner + [0,1] edge_u + [0,1] edge_v``.
+
+    Structural springs join grid neighbours; ``shear`` adds both diagonals of every cell and
+    ``bend`` adds springs skipping one particle. Rest lengths are the initial distances.
+    Returns ``(indices, springs)`` with ``indices`` of shape ``(nu, nv)``.
+    """
+    nu, nv = int(nu), int(nv)
+    if nu < 2 or nv < 2:
+        raise ValueError(f"cloth needs nu >= 2 and nv >= 2, got nu={nu!r}, nv={nv!r}")
+    c = vector("corner", corner, sim.dim)
+    u = vector("edge_u", edge_u, sim.dim)
+    v = vector("edge_v", edge_v, sim.dim)
+    positive_float("mass", mass)
+    nonnegative_float("k", k)
+    nonnegative_float("damping", damping)
+    fu = np.linspace(0.0, 1.0, nu)[:, None, None]
+    fv = np.linspace(0.0, 1.0, nv)[None, :, None]
+    grid = c + fu * u + fv * v
+    idx = sim.add_many(mass=mass, pos=grid.reshape(-1, sim.dim)).reshape(nu, nv)
+    pairs = [np.column_stack((idx[:-1, :].ravel(), idx[1:, :].ravel())),
+             np.column_stack((idx[:, :-1].ravel(), idx[:, 1:].ravel()))]
+    if shear:
+        pairs.append(np.column_stack((idx[:-1, :-1].ravel(), idx[1:, 1:].ravel())))
+        pairs.append(np.column_stack((idx[1:, :-1].ravel(), idx[:-1, 1:].ravel())))
+    if bend:
+        if nu > 2:
+            pairs.append(np.column_stack((idx[:-2, :].ravel(), idx[2:, :].ravel())))
+        if nv > 2:
+            pairs.append(np.column_stack((idx[:, :-2].ravel(), idx[:, 2:].ravel())))
+    pairs = np.concatenate(pairs)
+    flat = grid.reshape(-1, sim.dim)
+    lookup = {int(i): row for row, i in enumerate(idx.ravel())}
+    a = flat[[lookup[int(i)] for i in pairs[:, 0]]]
+    b = flat[[lookup[int(i)] for i in pairs[:, 1]]]
+    rest = np.linalg.norm(b - a, axis=1)
+    springs = Springs(pairs, k=k, rest_length=rest, damping=damping)
+    sim.add_force(springs)
+    return idx, springs

@@ -1,0 +1,67 @@
+"""Gravity near a planet's surface: the same acceleration g for every particle.
+
+f = m g,  a = g,  U = -sum_i m_i g . p_i      (lecture, "gravitational forces near a planet")
+"""
+from numba import njit
+
+from .base import Force, EMPTY_INTS
+from .._validate import vector
+
+KIND = 2
+
+
+@njit(cache=True)
+def accumulate(t, pos, vel, prm, n, fp, ip, acc):
+    active = prm[3]
+    dim = pos.shape[0]
+    for i in range(n):
+        if not active[i]:
+            continue
+        for k in range(dim):
+            acc[k, i] += fp[k]
+
+
+@njit(cache=True)
+def potential(t, pos, vel, prm, n, fp, ip):
+    mass = prm[0]
+    active = prm[3]
+    dim = pos.shape[0]
+    u = 0.0
+    for i in range(n):
+        if not active[i]:
+            continue
+        for k in range(dim):
+            u -= mass[i] * fp[k] * pos[k, i]
+    return u
+
+
+class UniformGravity(Force):
+    """Constant gravitational acceleration ``g`` (a vector of the simulation's dimension)."""
+
+    KIND = KIND
+    conservative = True
+
+    def __init__(self, g=(0.0, -9.8)):
+        super().__init__()
+        self._g = vector("g", g)
+
+    @property
+    def g(self):
+        return self._g.copy()
+
+    @g.setter
+    def g(self, value):
+        dim = self._sim.dim if self._sim is not None else None
+        self._g = vector("g", value, dim)
+        self._touch()
+
+    def _check(self, sim):
+        if self._g.shape[0] != sim.dim:
+            raise ValueError(f"UniformGravity g must have length {sim.dim} (the simulation's dim), "
+                             f"got {tuple(self._g)}")
+
+    def _pack(self, sim):
+        return self._g.copy(), EMPTY_INTS
+
+    def __repr__(self):
+        return f"UniformGravity(g={tuple(self._g)!r})"

@@ -1,0 +1,101 @@
+"""Wind pressure on triangles (cloth, sails, leaves), in 3-D.
+
+For a triangle (p0, p1, p2) and wind pressure vector w:
+
+    f = | 1/2 (p1 - p0) x (p2 - p0) . w |  w / |w|
+
+applied one third on each vertex (lecture, "wind pressure"): the more of the area faces the
+wind, the larger the push, always along the wind. Not conservative.
+"""
+import math
+
+import numpy as np
+from numba import njit
+
+from ._kernels import add_force
+from .base import Force
+from .._validate import vector
+
+KIND = 7
+
+
+@njit(cache=True)
+def accumulate(t, pos, vel, prm, n, fp, ip, acc):
+    mass = prm[0]
+    active = prm[3]
+    wx, wy, wz = fp[0], fp[1], fp[2]
+    wn = math.sqrt(wx * wx + wy * wy + wz * wz)
+    if wn == 0.0:
+        return
+    for s in range(ip.shape[0] // 3):
+        a = ip[3 * s]
+        b = ip[3 * s + 1]
+        c = ip[3 * s + 2]
+        if not (active[a] and active[b] and active[c]):
+            continue
+        ux = pos[0, b] - pos[0, a]
+        uy = pos[1, b] - pos[1, a]
+        uz = pos[2, b] - pos[2, a]
+        vx = pos[0, c] - pos[0, a]
+        vy = pos[1, c] - pos[1, a]
+        vz = pos[2, c] - pos[2, a]
+        nx = uy * vz - uz * vy
+        ny = uz * vx - ux * vz
+        nz = ux * vy - uy * vx
+        # third of the triangle's force, per unit wind direction
+        f = abs(0.5 * (nx * wx + ny * wy + nz * wz)) / (3.0 * wn)
+        for v in (a, b, c):
+            add_force(acc, v, 3, f * wx, f * wy, f * wz, mass[v])
+
+
+@njit(cache=True)
+def potential(t, pos, vel, prm, n, fp, ip):
+    return 0.0
+
+
+class Wind(Force):
+    """Wind pressure ``w`` (3-vector) on ``triangles`` (M x 3 particle indices); 3-D only."""
+
+    KIND = KIND
+
+    def __init__(self, w, triangles):
+        super().__init__()
+        self._w = vector("w", w, 3)
+        try:
+            tri = np.array(triangles, dtype=np.int64)
+        except (TypeError, ValueError, OverflowError):
+            raise TypeError(f"triangles must be (M, 3) particle indices, got {triangles!r}") from None
+        if tri.size == 0:
+            tri = tri.reshape(0, 3)
+        if tri.ndim != 2 or tri.shape[1] != 3:
+            raise ValueError(f"triangles must have shape (M, 3), got shape {tri.shape}")
+        self.triangles = tri
+
+    @property
+    def w(self):
+        return self._w.copy()
+
+    @w.setter
+    def w(self, value):
+        self._w = vector("w", value, 3)
+        self._touch()
+
+    def _check(self, sim):
+        if sim.dim != 3:
+            raise ValueError(f"Wind acts on triangles and needs dim=3, the simulation has dim={sim.dim}")
+        bad = (self.triangles < 0) | (self.triangles >= sim.n)
+        if np.any(bad):
+            s, c = np.argwhere(bad)[0]
+            raise ValueError(f"triangles[{s}][{c}] = {self.triangles[s, c]} is out of range "
+                             f"(the simulation has {sim.n} particles)")
+
+    def _pack(self, sim):
+        return self._w.copy(), self.triangles.reshape(-1).copy()
+
+
+def grid_triangles(indices):
+    """The two triangles of every cell of an ``(nu, nv)`` index grid (e.g. from ``cloth``)."""
+    idx = np.asarray(indices)
+    a, b = idx[:-1, :-1].ravel(), idx[1:, :-1].ravel()
+    c, d = idx[1:, 1:].ravel(), idx[:-1, 1:].ravel()
+    return np.concatenate((np.column_stack((a, b, c)), np.column_stack((a, c, d))))

@@ -1,0 +1,64 @@
+"""Pieces every integrator shares: drift, kick, save/restore and the finiteness check.
+
+Every integrator module exposes ``advance(t, h, steps, pos, vel, prm, n, model, vdep, t_end)``
+returning ``(t, h_next, done, bad)``: the new time, the step to use next (``h`` for fixed-step
+methods), the number of steps completed, and ``bad`` = -1 on success, the index of the first
+non-finite particle when a step blew up (the state is then the last finite one and ``done`` is
+the index of the failing step), or -2 when an adaptive step size collapsed. ``t_end`` is only
+used by adaptive methods (they shorten their last step to land on it; NaN means no target).
+"""
+import math
+
+from numba import njit
+
+OK = -1
+STEP_COLLAPSED = -2
+
+
+@njit(cache=True)
+def drift(pos, vel, active, n, h):
+    """p <- p + h v for every active particle."""
+    for k in range(pos.shape[0]):
+        for i in range(n):
+            if active[i]:
+                pos[k, i] += h * vel[k, i]
+
+
+@njit(cache=True)
+def kick(vel, acc, active, n, h):
+    """v <- v + h a for every active particle."""
+    for k in range(vel.shape[0]):
+        for i in range(n):
+            if active[i]:
+                vel[k, i] += h * acc[k, i]
+
+
+@njit(cache=True)
+def copy_state(src_pos, src_vel, dst_pos, dst_vel, n):
+    for k in range(src_pos.shape[0]):
+        for i in range(n):
+            dst_pos[k, i] = src_pos[k, i]
+            dst_vel[k, i] = src_vel[k, i]
+
+
+@njit(cache=True)
+def first_nonfinite(pos, vel, active, n):
+    """Index of the first active particle with a non-finite position or velocity, else -1."""
+    for i in range(n):
+        if not active[i]:
+            continue
+        for k in range(pos.shape[0]):
+            if not (math.isfinite(pos[k, i]) and math.isfinite(vel[k, i])):
+                return i
+    return -1
+
+
+@njit(cache=True)
+def first_nonfinite_array(a, active, n):
+    for i in range(n):
+        if not active[i]:
+            continue
+        for k in range(a.shape[0]):
+            if not math.isfinite(a[k, i]):
+                return i
+    return -1

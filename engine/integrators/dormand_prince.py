@@ -1,0 +1,132 @@
+"""Adaptive Dormand-Prince 5(4) Runge-Kutta with error control (``rk45``).
+
+Seven stages, first-same-as-last, fifth-order solution, embedded fourth-order error estimate
+(Dormand & Prince, J. Comput. Appl. Math. 6 (1980) 19; tableau as in Hairer, Norsett & Wanner,
+Solving ODEs I, table II.5.2). The error of a step is
+
+    err = max_i |y5_i - y4_i| / (tol (1 + max(|y_i|, |y_new_i|)))
+
+over every position and velocity component of the active particles (``tol`` is both the
+relative and the absolute tolerance). A step with err > 1, or with a non-finite stage, is
+rejected and retried with h * max(0.2, 0.9 err^(-1/5)); an accepted one proposes
+h * min(5, max(0.2, 0.9 err^(-1/5))) for the next (no growth right after a rejection).
+"""
+import math
+
+import numpy as np
+from numba import njit
+
+from ..forces.dispatch import accelerations
+from .common import OK, STEP_COLLAPSED, first_nonfinite, first_nonfinite_array
+
+NAME = "rk45"
+ORDER = 5
+
+_C = np.array([0.0, 1 / 5, 3 / 10, 4 / 5, 8 / 9, 1.0, 1.0])
+_A = np.array([
+    [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+    [1 / 5, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+    [3 / 40, 9 / 40, 0.0, 0.0, 0.0, 0.0, 0.0],
+    [44 / 45, -56 / 15, 32 / 9, 0.0, 0.0, 0.0, 0.0],
+    [19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729, 0.0, 0.0, 0.0],
+    [9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656, 0.0, 0.0],
+    [35 / 384, 0.0, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84, 0.0],
+])
+# fifth-order weights minus fourth-order weights
+_E = np.array([71 / 57600, 0.0, -71 / 16695, 71 / 1920, -17253 / 339200, 22 / 525, -1 / 40])
+
+_SAFETY = 0.9
+_MIN_FACTOR = 0.2
+_MAX_FACTOR = 5.0
+
+
+@njit(cache=True)
+def _stage_state(pos, vel, kx, kv, s, h, n, out_pos, out_vel):
+    """y + h sum_{j<s} a_sj k_j."""
+    for k in range(pos.shape[0]):
+        for i in range(n):
+            x = pos[k, i]
+            v = vel[k, i]
+            for j in range(s):
+                a = _A[s, j]
+                if a != 0.0:
+                    x += h * a * kx[j, k, i]
+                    v += h * a * kv[j, k, i]
+            out_pos[k, i] = x
+            out_vel[k, i] = v
+
+
+@njit(cache=True)
+def _error(pos, vel, new_pos, new_vel, kx, kv, h, tol, active, n):
+    err = 0.0
+    for k in range(pos.shape[0]):
+        for i in range(n):
+            if not active[i]:
+                continue
+            ex = 0.0
+            ev = 0.0
+            for j in range(7):
+                ex += _E[j] * kx[j, k, i]
+                ev += _E[j] * kv[j, k, i]
+            sx = tol * (1.0 + max(abs(pos[k, i]), abs(new_pos[k, i])))
+            sv = tol * (1.0 + max(abs(vel[k, i]), abs(new_vel[k, i])))
+            err = max(err, abs(h * ex) / sx, abs(h * ev) / sv)
+    return err
+
+
+@njit(cache=True)
+def advance(t, h, steps, pos, vel, prm, n, model, vdep, t_end, tol):
+    active = prm[3]
+    dim = pos.shape[0]
+    kx = np.empty((7, dim, n))
+    kv = np.empty((7, dim, n))
+    sx = np.empty((dim, n))
+    sv = np.empty((dim, n))
+    has_end = not math.isnan(t_end)
+    kx[0, :, :] = vel[:, :n]
+    accelerations(t, pos, vel, prm, n, model, kv[0])
+    done = 0
+    rejected = False
+    while done < steps:
+        h_try = h
+        last = False
+        if has_end:
+            remaining = t_end - t
+            if remaining == 0.0:
+                break
+            if abs(h) >= abs(remaining):
+                h_try = remaining
+                last = True
+        for s in range(1, 7):
+            _stage_state(pos, vel, kx, kv, s, h_try, n, sx, sv)
+            kx[s, :, :] = sv
+            accelerations(t + _C[s] * h_try, sx, sv, prm, n, model, kv[s])
+        # stage 7 state is the fifth-order solution (sx, sv)
+        bad = first_nonfinite(sx, sv, active, n)
+        if bad < 0:
+            bad = first_nonfinite_array(kv[6], active, n)
+        err = math.inf if bad >= 0 else _error(pos, vel, sx, sv, kx, kv, h_try, tol, active, n)
+        if err > 1.0:
+            factor = _MIN_FACTOR if math.isinf(err) else max(_MIN_FACTOR, _SAFETY * err ** -0.2)
+            h = h_try * factor
+            rejected = True
+            if abs(h) <= 1e-14 * max(1.0, abs(t)):
+                if bad < 0:
+                    bad = first_nonfinite_array(kv[0], active, n)
+                return t, h, done, bad if bad >= 0 else STEP_COLLAPSED
+            continue
+        pos[:, :n] = sx
+        vel[:, :n] = sv
+        t = t_end if last else t + h_try
+        kx[0, :, :] = kx[6]
+        kv[0, :, :] = kv[6]
+        factor = _MAX_FACTOR if err == 0.0 else min(_MAX_FACTOR, max(_MIN_FACTOR, _SAFETY * err ** -0.2))
+        if rejected:
+            factor = min(factor, 1.0)
+        rejected = False
+        if not last or abs(h_try * factor) < abs(h):
+            h = h_try * factor
+        done += 1
+        if last:
+            break
+    return t, h, done, OK

@@ -1,0 +1,39 @@
+"""Forward (explicit) Euler, exactly the lecture's pseudo code.
+
+    a_i = f(p_i, v_i) / m;   p_{i+1} = p_i + v_i dt;   v_{i+1} = v_i + a_i dt
+
+First order, not symplectic: the energy of a bound orbit grows step after step.
+"""
+import numpy as np
+from numba import njit
+
+from ..forces.dispatch import accelerations
+from .common import OK, copy_state, first_nonfinite
+
+NAME = "euler"
+ORDER = 1
+FORCE_EVALUATIONS = 1
+
+
+@njit(cache=True)
+def advance(t, h, steps, pos, vel, prm, n, model, vdep, t_end):
+    active = prm[3]
+    dim = pos.shape[0]
+    acc = np.empty((dim, n))
+    save_pos = np.empty((dim, n))
+    save_vel = np.empty((dim, n))
+    t0 = t
+    for step in range(steps):
+        copy_state(pos, vel, save_pos, save_vel, n)
+        accelerations(t, pos, vel, prm, n, model, acc)
+        for k in range(dim):
+            for i in range(n):
+                if active[i]:
+                    pos[k, i] += h * vel[k, i]
+                    vel[k, i] += h * acc[k, i]
+        bad = first_nonfinite(pos, vel, active, n)
+        if bad >= 0:
+            copy_state(save_pos, save_vel, pos, vel, n)
+            return t, h, step, bad
+        t = t0 + (step + 1) * h
+    return t, h, steps, OK

@@ -1,0 +1,207 @@
+"""Integrators: order of convergence, energy behaviour, reversibility, landing on t, rk45."""
+import math
+
+import numpy as np
+import pytest
+
+import engine
+from engine import Simulation, analytic, forces
+
+from .conftest import kepler_initial, kepler_sim
+
+T_END = 2.0  # not a whole period: symplectic Euler's O(h) offset would cancel at pericentre
+
+
+def kepler_error(integrator, steps, e=0.5):
+    sim = kepler_sim(e, integrator, T_END / steps)
+    sim.step(steps)
+    r0, v0 = kepler_initial(e)
+    r, v = analytic.kepler(r0, v0, 1.0, T_END)
+    assert sim.t == pytest.approx(T_END, rel=1e-12)
+    return float(np.max(np.abs(np.r_[sim.pos[0] - r, sim.vel[0] - v])))
+
+
+@pytest.mark.parametrize("integrator, order, steps", [
+    ("euler", 1, (4000, 8000, 16000)),
+    ("symplectic_euler", 1, (4000, 8000, 16000)),
+    ("leapfrog", 2, (400, 800, 1600)),
+    ("verlet", 2, (400, 800, 1600)),
+    ("rk4", 4, (100, 200, 400)),
+    ("yoshida4", 4, (100, 200, 400)),
+    ("pefrl", 4, (50, 100, 200)),
+])
+def test_empirical_order_of_convergence_on_kepler(integrator, order, steps):
+    errors = [kepler_error(integrator, s) for s in steps]
+    slopes = [math.log2(errors[i] / errors[i + 1]) for i in range(len(errors) - 1)]
+    for slope in slopes:
+        assert slope == pytest.approx(order, abs=0.15), (errors, slopes)
+    assert engine.ORDERS[integrator] == order
+
+
+def _energy_errors(integrator, orbits, steps_per_orbit, e=0.5, samples=None):
+    period = 2 * math.pi
+    sim = kepler_sim(e, integrator, period / steps_per_orbit)
+    e0 = sim.energy()
+    out = []
+    for _ in range(orbits):
+        sim.step(steps_per_orbit)
+        out.append(abs(sim.energy() - e0) / abs(e0))
+    return np.array(out)
+
+
+def _energy_error_windows(integrator, orbits, steps_per_orbit, window=10, e=0.5):
+    """Max relative energy error over every step of the first and of the last ``window`` orbits."""
+    sim = kepler_sim(e, integrator, 2 * math.pi / steps_per_orbit)
+    e0 = sim.energy()
+
+    def window_max():
+        worst = 0.0
+        for _ in range(window * steps_per_orbit):
+            sim.step()
+            worst = max(worst, abs(sim.energy() - e0) / abs(e0))
+        return worst
+
+    early = window_max()
+    sim.step((orbits - 2 * window) * steps_per_orbit)
+    return early, window_max()
+
+
+@pytest.mark.parametrize("integrator", ["symplectic_euler", "leapfrog", "verlet", "yoshida4", "pefrl"])
+def test_symplectic_energy_error_bounded_over_1000_orbits(integrator):
+    early, late = _energy_error_windows(integrator, 1000, 200)
+    # bounded: the worst error of the last 10 orbits is no larger than that of the first 10
+    assert late < 1.2 * early, (early, late)
+    assert early < {"symplectic_euler": 0.2, "leapfrog": 5e-3, "verlet": 5e-3}.get(integrator, 1e-4)
+
+
+def test_explicit_euler_energy_grows():
+    err = _energy_errors("euler", 100, 20000)
+    assert np.all(np.diff(err) > 0)  # every orbit gains energy
+    assert err[9] > 5 * err[0] and err[99] > 5 * err[9]
+
+
+def test_rk4_energy_drifts_linearly():
+    err = _energy_errors("rk4", 400, 100)
+    # RK4 dissipates: the error at 400 orbits is about 4 times that at 100
+    assert 3.0 < err[399] / err[99] < 5.0
+
+
+@pytest.mark.parametrize("integrator", ["leapfrog", "verlet", "yoshida4", "pefrl"])
+def test_time_reversibility(integrator):
+    sim = kepler_sim(0.7, integrator, 0.01)
+    start = np.r_[sim.pos[0], sim.vel[0]]
+    sim.step(5000)
+    assert np.max(np.abs(np.r_[sim.pos[0], sim.vel[0]] - start)) > 0.1
+    sim.dt = -sim.dt
+    sim.step(5000)
+    # back to the start up to round-off (about 1e-12 per step of drift, over 10^4 steps)
+    np.testing.assert_allclose(np.r_[sim.pos[0], sim.vel[0]], start, rtol=0, atol=1e-10)
+    assert abs(sim.t) < 1e-12
+
+
+@pytest.mark.parametrize("integrator", engine.INTEGRATORS)
+def test_every_integrator_runs_backwards(integrator):
+    sim = kepler_sim(0.3, integrator, -0.001)
+    sim.step(1000)
+    assert sim.t == pytest.approx(-1.0, rel=1e-9) if integrator != "rk45" else sim.t < -1.0
+    r0, v0 = kepler_initial(0.3)
+    r, _ = analytic.kepler(r0, v0, 1.0, sim.t)
+    tol = {"euler": 2e-3, "symplectic_euler": 2e-3}.get(integrator, 1e-5)
+    np.testing.assert_allclose(sim.pos[0], r, atol=tol)
+
+
+@pytest.mark.parametrize("integrator", engine.INTEGRATORS)
+def test_integrate_lands_exactly_on_t(integrator):
+    sim = kepler_sim(0.5, integrator, 0.03)
+    sim.integrate(1.0)
+    assert sim.t == 1.0
+    sim.integrate(0.25)  # and back
+    assert sim.t == 0.25
+    r0, v0 = kepler_initial(0.5)
+    r, _ = analytic.kepler(r0, v0, 1.0, 0.25)
+    tol = {"euler": 0.1, "symplectic_euler": 0.05, "leapfrog": 1e-3, "verlet": 1e-3}.get(integrator, 1e-4)
+    np.testing.assert_allclose(sim.pos[0], r, atol=tol)
+
+
+def test_integrate_partial_last_step_is_consistent():
+    # integrate(t) with a partial last step equals whole steps when dt divides t
+    a = kepler_sim(0.5, "leapfrog", 0.1)
+    a.integrate(1.05)
+    b = kepler_sim(0.5, "leapfrog", 0.1)
+    b.step(10)
+    b.dt = 0.05
+    b.step(1)
+    np.testing.assert_allclose(a.pos, b.pos, rtol=1e-13)
+    assert a.dt == 0.1  # the user's step is unchanged by integrate
+
+
+def test_rk45_error_follows_tolerance():
+    r0, v0 = kepler_initial(0.9)
+    t_end = 10 * 2 * math.pi
+    r, _ = analytic.kepler(r0, v0, 1.0, t_end)
+    tolerances = np.array([1e-6, 1e-8, 1e-10, 1e-12])
+    errors, steps = [], []
+    for tol in tolerances:
+        sim = kepler_sim(0.9, "rk45", 0.01, tolerance=tol)
+        sim.integrate(t_end)
+        errors.append(np.max(np.abs(sim.pos[0] - r)))
+        steps.append(sim.steps)
+    errors = np.array(errors)
+    assert np.all(np.diff(errors) < 0) and np.all(np.diff(steps) > 0)
+    # global error proportional to the tolerance: fitted slope about 1 in log-log
+    slope = np.polyfit(np.log10(tolerances), np.log10(errors), 1)[0]
+    assert 0.8 < slope < 1.2, (errors, slope)
+    # over 10 eccentric orbits the global error stays within 1e5 x the local tolerance
+    assert np.all(errors < 1e5 * tolerances)
+
+
+def test_rk45_rejects_and_adapts_at_pericentre():
+    sim = kepler_sim(0.99, "rk45", 1.0, tolerance=1e-9)  # a huge first step must be rejected
+    sim.integrate(2 * math.pi)
+    r0, v0 = kepler_initial(0.99)
+    np.testing.assert_allclose(sim.pos[0], r0, atol=1e-5)
+    assert sim.steps > 50
+
+
+def test_rk45_step_counts_accepted_steps_and_adapts_dt():
+    sim = kepler_sim(0.5, "rk45", 1e-3, tolerance=1e-8)
+    sim.step(10)
+    assert sim.steps == 10
+    assert sim.dt > 1e-3  # grew from the first step
+
+
+def test_force_evaluations_table():
+    assert engine.integrators.FORCE_EVALUATIONS == {
+        "euler": 1, "symplectic_euler": 1, "leapfrog": 1, "verlet": 1, "rk4": 4,
+        "yoshida4": 3, "pefrl": 4, "rk45": 6}
+
+
+def test_verlet_equals_leapfrog_shifted_by_half_a_kick():
+    # KDK and DKD are the same scheme up to where the step starts: both are 2nd order and
+    # their positions agree to O(dt^2) at all times
+    a = kepler_sim(0.5, "verlet", 1e-3)
+    b = kepler_sim(0.5, "leapfrog", 1e-3)
+    a.step(1000)
+    b.step(1000)
+    np.testing.assert_allclose(a.pos, b.pos, atol=1e-5)
+
+
+def _damped_oscillator_error(integrator, dt, t_end=3.0):
+    sim = Simulation(dim=2, integrator=integrator, dt=dt)
+    sim.add(mass=1.0, pos=(1.0, 0.0))
+    anchor = sim.add(mass=1e15, pos=(0.0, 0.0))
+    sim.add_force(forces.Springs([(0, anchor)], k=4.0, rest_length=0.0, damping=0.4))
+    sim.integrate(t_end)
+    x, _ = analytic.harmonic_oscillator(1.0, 0.0, 2.0, t_end, zeta=0.1)
+    return abs(sim.pos[0, 0] - float(x))
+
+
+@pytest.mark.parametrize("integrator, order", [
+    ("verlet", 1), ("leapfrog", 1), ("yoshida4", 1), ("rk4", 4), ("euler", 1)])
+def test_velocity_dependent_forces_converge(integrator, order):
+    # a damped oscillator: the damping force is re-evaluated with the current velocities, so
+    # every method converges; splitting methods drop to first order in the damping term
+    e1 = _damped_oscillator_error(integrator, 2e-3)
+    e2 = _damped_oscillator_error(integrator, 1e-3)
+    assert math.log2(e1 / e2) > order - 0.2, (e1, e2)
+    assert e2 < {"rk4": 1e-11, "euler": 1e-2}.get(integrator, 1e-3)
