@@ -173,22 +173,25 @@ def universal_anomaly(r0n, sigma0, alpha, tau):
     sig = d * sigma0
 
     lo = 0.0
+    y = -1.0
     if alpha > 0.0:
         hi = _TWO_PI / math.sqrt(alpha)  # one full period: tau(hi) = 2pi/alpha^1.5
         y = target * alpha
-        if not (y < hi):
-            y = 0.5 * hi
     else:
         hi = np.inf
-        y = min(target / r0n, np.cbrt(6.0 * target))
         if alpha < 0.0:
             sqa = math.sqrt(-1.0 / alpha)
             den = sig + sqa * (1.0 - r0n * alpha)
-            arg = -2.0 * alpha * target / den
-            if den > 0.0 and arg > 1.0 and arg < np.inf:
-                y = sqa * math.log(arg)
-        if not (y > 0.0):
-            y = target / r0n
+            if den > 0.0:
+                arg = -2.0 * alpha * target / den
+                if arg > 1.0:
+                    y = sqa * math.log(arg)
+    if not (0.0 < y < hi):
+        y = np.cbrt(6.0 * target)
+        if r0n > 0.0:
+            y = min(y, target / r0n)
+        if not (y < hi):
+            y = 0.5 * hi
     if not (y > 0.0):
         # target so small that chi underflows: the state does not move.
         return 0.0
@@ -302,15 +305,113 @@ def lagrange_coefficients(r0, v0, mu, t):
     return f, g, fdot, gdot
 
 
+# An unbound state farther than this many periapsis distances from the focus
+# is propagated from periapsis instead of from itself (see kepler_step).  Below
+# it the hyperbolic anomaly |H0| < 1.4 (parabolic anomaly tan(nu/2) < 1), so
+# the direct universal form loses at most a factor e^(2|H0|) ~ 16.
+_FAR_FROM_PERIAPSIS = 2.0
+
+
 @njit(cache=True, error_model="numpy")
 def kepler_step(r0, v0, mu, t, r_out, v_out):
     """Advance a Kepler state by ``t`` and write it to ``r_out``, ``v_out``.
 
     Same physics as :func:`kepler`; no validation.  ``r_out``/``v_out`` may be
     the very arrays ``r0``/``v0`` (in-place update for a game loop).
+
+    Bound states, and unbound ones near periapsis, use the Lagrange
+    coefficients of :func:`lagrange_coefficients`.  Unbound (hyperbolic or
+    parabolic) states far out (``|r0| > 2 q``) are handled differently: from
+    there U1..U3 grow like ``e^|dH|`` (or ``chi^3``), and the terms of both
+    Kepler's equation and ``r = f r0 + g v0`` cancel to a tiny fraction of
+    their size -- a flyby started 1e4 |a| out loses ~8 digits.  Such orbits
+    are re-expressed about periapsis, where ``sigma = 0`` and nothing cancels.
+    With ``p = h^2/mu``, ``e = sqrt(1 - alpha p)``, ``q = p / (1 + e)``,
+    ``P = e_vec / |e_vec|``, ``Q = h x P / |h|`` (Bate, Mueller & White 1971,
+    ch. 2 and 4; Battin 1999, sec. 4.5)::
+
+        U1(chi_p) = sigma0 / (1 - alpha q)          (state's anomaly from q)
+        sqrt(mu) t_p = q U1(chi_p) + U3(chi_p)      (time since periapsis)
+        sqrt(mu) (t_p + t) = q U1(chi) + U3(chi),   r = q U0 + U2
+        r_vec = (q - U2) P + (h U1 / sqrt(mu)) Q
+        v_vec = -(sqrt(mu) U1 / r) P + (h U0 / r) Q
+
+    ``chi_p = asinh(sqrt(-alpha) U1) / sqrt(-alpha)`` (``= U1`` for a
+    parabola).  Errors then stay at the level set by rounding of the input.
+    A radial orbit (``h = 0``, ``q = 0``) passes through the focus at
+    ``t_p = 0`` and is continued as a bounce, like the bound radial case.
     """
+    n = r0.shape[0]
+    r0n2 = 0.0
+    v02 = 0.0
+    rv = 0.0
+    for i in range(n):
+        r0n2 += r0[i] * r0[i]
+        v02 += v0[i] * v0[i]
+        rv += r0[i] * v0[i]
+    r0n = math.sqrt(r0n2)
+    alpha = 2.0 / r0n - v02 / mu
+    if alpha <= 0.0:
+        if n == 3:
+            hx = r0[1] * v0[2] - r0[2] * v0[1]
+            hy = r0[2] * v0[0] - r0[0] * v0[2]
+            hz = r0[0] * v0[1] - r0[1] * v0[0]
+        else:
+            hx = 0.0
+            hy = 0.0
+            hz = r0[0] * v0[1] - r0[1] * v0[0]
+        h2 = hx * hx + hy * hy + hz * hz
+        # e^2 = 1 - alpha p has no cancellation for alpha <= 0, unlike |e_vec|.
+        e = math.sqrt(1.0 - alpha * h2 / mu)
+        q = h2 / (mu * (1.0 + e))
+        if r0n > _FAR_FROM_PERIAPSIS * q:
+            h = math.sqrt(h2)
+            sqmu = math.sqrt(mu)
+            u1p = rv / sqmu / (1.0 - alpha * q)
+            chip = u1p
+            if alpha < 0.0:
+                sa = math.sqrt(-alpha)
+                y = sa * u1p
+                if y != 0.0:
+                    chip = math.asinh(y) / sa
+            _, _, _, u3p = _universal_functions(chip, alpha)
+            # Both terms have the sign of chip: the sum cannot cancel.
+            tau = (q * u1p + u3p) + sqmu * t
+            chi = universal_anomaly(q, 0.0, alpha, tau)
+            u0, u1, u2, u3 = _universal_functions(chi, alpha)
+            r = q * u0 + u2
+            xp = q - u2
+            yq = h * u1 / sqmu
+            vp = -sqmu * u1 / r
+            vq = h * u0 / r
+            k = v02 - mu / r0n
+            ex = k * r0[0] - rv * v0[0]  # mu * e_vec; only its direction is used
+            ey = k * r0[1] - rv * v0[1]
+            ez = k * r0[2] - rv * v0[2] if n == 3 else 0.0
+            en = math.sqrt(ex * ex + ey * ey + ez * ez)
+            px = ex / en
+            py = ey / en
+            pz = ez / en
+            if h > 0.0:
+                qx = (hy * pz - hz * py) / h
+                qy = (hz * px - hx * pz) / h
+                qz = (hx * py - hy * px) / h
+            else:
+                # Radial: no Q direction, and yq = vq = 0 anyway.
+                qx = 0.0
+                qy = 0.0
+                qz = 0.0
+            # All reads of r0/v0 are done, so writing aliased outputs is safe.
+            r_out[0] = xp * px + yq * qx
+            r_out[1] = xp * py + yq * qy
+            v_out[0] = vp * px + vq * qx
+            v_out[1] = vp * py + vq * qy
+            if n == 3:
+                r_out[2] = xp * pz + yq * qz
+                v_out[2] = vp * pz + vq * qz
+            return
     f, g, fdot, gdot = lagrange_coefficients(r0, v0, mu, t)
-    for i in range(r0.shape[0]):
+    for i in range(n):
         # Read both components before writing, so aliasing is safe.
         ri = r0[i]
         vi = v0[i]

@@ -2,7 +2,7 @@
 from numba import njit
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, error_model="numpy", inline="always")
 def add_force(acc, i, dim, f0, f1, f2, m):
     """acc_i += f / m_i, skipping an exact zero force so a massless particle with no force
     stays finite (a massless particle *with* a force becomes infinite and the step fails)."""
@@ -14,7 +14,7 @@ def add_force(acc, i, dim, f0, f1, f2, m):
         acc[2, i] += f2 / m
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, error_model="numpy", inline="always")
 def delta(pos, i, j, dim):
     """The separation p_j - p_i as three floats (z = 0 in 2-D)."""
     dx = pos[0, j] - pos[0, i]

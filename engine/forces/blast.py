@@ -19,7 +19,7 @@ from .._validate import finite_float, positive_float, vector
 KIND = 9
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def accumulate(t, pos, vel, prm, n, fp, ip, acc):
     mass = prm[0]
     active = prm[3]
@@ -42,7 +42,7 @@ def accumulate(t, pos, vel, prm, n, fp, ip, acc):
         add_force(acc, i, dim, s * dx, s * dy, s * dz, mass[i])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def potential(t, pos, vel, prm, n, fp, ip):
     return 0.0
 

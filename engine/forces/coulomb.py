@@ -18,7 +18,7 @@ from .._validate import nonnegative_float, finite_float
 KIND = 3
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def accumulate(t, pos, vel, prm, n, fp, ip, acc):
     mass, charge, _, active, _ = prm
     k = fp[0]
@@ -38,7 +38,7 @@ def accumulate(t, pos, vel, prm, n, fp, ip, acc):
             add_force(acc, j, dim, s * dx, s * dy, s * dz, mass[j])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def potential(t, pos, vel, prm, n, fp, ip):
     _, charge, _, active, _ = prm
     k = fp[0]

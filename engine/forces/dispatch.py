@@ -12,7 +12,7 @@ from . import (blast, buoyancy, coulomb, drag, gravity, point_mass, springs, thr
                uniform_gravity, wind)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def accelerations(t, pos, vel, prm, n, model, acc):
     """Overwrite ``acc[:, :n]`` with the total acceleration of every declared term at time t."""
     kinds, fp_all, foff, ip_all, ioff = model
@@ -45,7 +45,7 @@ def accelerations(t, pos, vel, prm, n, model, acc):
             blast.accumulate(t, pos, vel, prm, n, fp, ip, acc)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def potential_terms(t, pos, vel, prm, n, model, out):
     """Write each term's potential energy into ``out[s]`` (0 for non-conservative terms)."""
     kinds, fp_all, foff, ip_all, ioff = model

@@ -14,7 +14,7 @@ from .._validate import nonnegative_float
 KIND = 5
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def accumulate(t, pos, vel, prm, n, fp, ip, acc):
     mass = prm[0]
     active = prm[3]
@@ -31,7 +31,7 @@ def accumulate(t, pos, vel, prm, n, fp, ip, acc):
         add_force(acc, i, dim, s * vx, s * vy, s * vz, mass[i])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def potential(t, pos, vel, prm, n, fp, ip):
     return 0.0
 

@@ -19,7 +19,7 @@ from .._validate import nonnegative_float
 KIND = 0
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def accumulate(t, pos, vel, prm, n, fp, ip, acc):
     mass, _, _, active, test = prm
     G = fp[0]
@@ -48,7 +48,7 @@ def accumulate(t, pos, vel, prm, n, fp, ip, acc):
                 acc[2, j] -= sj * dz
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def potential(t, pos, vel, prm, n, fp, ip):
     mass, _, _, active, test = prm
     G = fp[0]

@@ -18,7 +18,7 @@ import numpy as np
 KIND = 1
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def accumulate(t, pos, vel, prm, n, fp, ip, acc):
     active = prm[3]
     mu = fp[0]
@@ -41,7 +41,7 @@ def accumulate(t, pos, vel, prm, n, fp, ip, acc):
             acc[2, i] -= s * dz
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def potential(t, pos, vel, prm, n, fp, ip):
     mass = prm[0]
     active = prm[3]

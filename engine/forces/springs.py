@@ -23,7 +23,7 @@ from .._validate import per_item, vector, positive_float, nonnegative_float
 KIND = 4
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def accumulate(t, pos, vel, prm, n, fp, ip, acc):
     mass, _, _, active, _ = prm
     dim = pos.shape[0]
@@ -47,7 +47,7 @@ def accumulate(t, pos, vel, prm, n, fp, ip, acc):
         add_force(acc, b, dim, -scale * dx, -scale * dy, -scale * dz, mass[b])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def potential(t, pos, vel, prm, n, fp, ip):
     active = prm[3]
     dim = pos.shape[0]

@@ -13,7 +13,7 @@ from .._validate import vector
 KIND = 6
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def accumulate(t, pos, vel, prm, n, fp, ip, acc):
     mass = prm[0]
     active = prm[3]
@@ -26,7 +26,7 @@ def accumulate(t, pos, vel, prm, n, fp, ip, acc):
         add_force(acc, i, dim, fp[i * dim], fp[i * dim + 1], f2, mass[i])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def potential(t, pos, vel, prm, n, fp, ip):
     return 0.0
 

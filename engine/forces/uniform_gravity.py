@@ -10,7 +10,7 @@ from .._validate import vector
 KIND = 2
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def accumulate(t, pos, vel, prm, n, fp, ip, acc):
     active = prm[3]
     dim = pos.shape[0]
@@ -21,7 +21,7 @@ def accumulate(t, pos, vel, prm, n, fp, ip, acc):
             acc[k, i] += fp[k]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def potential(t, pos, vel, prm, n, fp, ip):
     mass = prm[0]
     active = prm[3]

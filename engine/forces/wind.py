@@ -19,7 +19,7 @@ from .._validate import vector
 KIND = 7
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def accumulate(t, pos, vel, prm, n, fp, ip, acc):
     mass = prm[0]
     active = prm[3]
@@ -48,7 +48,7 @@ def accumulate(t, pos, vel, prm, n, fp, ip, acc):
             add_force(acc, v, 3, f * wx, f * wy, f * wz, mass[v])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def potential(t, pos, vel, prm, n, fp, ip):
     return 0.0
 

@@ -15,7 +15,7 @@ OK = -1
 STEP_COLLAPSED = -2
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def drift(pos, vel, active, n, h):
     """p <- p + h v for every active particle."""
     for k in range(pos.shape[0]):
@@ -24,7 +24,7 @@ def drift(pos, vel, active, n, h):
                 pos[k, i] += h * vel[k, i]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def kick(vel, acc, active, n, h):
     """v <- v + h a for every active particle."""
     for k in range(vel.shape[0]):
@@ -33,7 +33,7 @@ def kick(vel, acc, active, n, h):
                 vel[k, i] += h * acc[k, i]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def copy_state(src_pos, src_vel, dst_pos, dst_vel, n):
     for k in range(src_pos.shape[0]):
         for i in range(n):
@@ -41,7 +41,7 @@ def copy_state(src_pos, src_vel, dst_pos, dst_vel, n):
             dst_vel[k, i] = src_vel[k, i]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def first_nonfinite(pos, vel, active, n):
     """Index of the first active particle with a non-finite position or velocity, else -1."""
     for i in range(n):
@@ -53,7 +53,7 @@ def first_nonfinite(pos, vel, active, n):
     return -1
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def first_nonfinite_array(a, active, n):
     for i in range(n):
         if not active[i]:

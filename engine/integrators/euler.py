@@ -15,7 +15,7 @@ ORDER = 1
 FORCE_EVALUATIONS = 1
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def advance(t, h, steps, pos, vel, prm, n, model, vdep, t_end):
     active = prm[3]
     dim = pos.shape[0]

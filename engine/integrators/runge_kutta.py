@@ -16,7 +16,7 @@ ORDER = 4
 FORCE_EVALUATIONS = 4
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _stage(pos, vel, dx, dv, c, n, out_pos, out_vel):
     """out = y + c * (dx, dv)."""
     for k in range(pos.shape[0]):
@@ -25,7 +25,7 @@ def _stage(pos, vel, dx, dv, c, n, out_pos, out_vel):
             out_vel[k, i] = vel[k, i] + c * dv[k, i]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def advance(t, h, steps, pos, vel, prm, n, model, vdep, t_end):
     active = prm[3]
     dim = pos.shape[0]

@@ -60,7 +60,7 @@ def force_evaluations(name):
     return kicks - (1 if starts_with_kick and ends_with_kick else 0)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def advance(t, h, steps, pos, vel, prm, n, model, vdep, t_end, drifts, kicks):
     active = prm[3]
     dim = pos.shape[0]
