@@ -8,11 +8,14 @@
     sim.add_force(forces.UniformGravity(g=(0.0, -1.0)))
     sim.step(7)
 """
-from . import analytic, clock, diagnostics, forces
-from .clock import FixedStepClock
-from .errors import SimulationError
-from .integrators import INTEGRATORS, ORDERS, SYMPLECTIC
-from .simulation import Simulation
+from ._cache import project_cache
+
+with project_cache():
+    from . import analytic, clock, diagnostics, forces, integrators
+    from .clock import FixedStepClock
+    from .errors import SimulationError
+    from .integrators import INTEGRATORS, ORDERS, SYMPLECTIC
+    from .simulation import Simulation
 
 __version__ = "0.1.0"
 

@@ -88,11 +88,85 @@ _SERIES_TERMS = 12
 # below one ulp.
 _CHI_RTOL = 1e-15
 _MAX_ITER = 300
+# A residual of Kepler's equation below this fraction of the sum of its terms'
+# magnitudes is rounding noise.
+_RESIDUAL_RTOL = 4.0 * 2.220446049250313e-16
 
 
 # ---------------------------------------------------------------------------
 # Compiled cores
 # ---------------------------------------------------------------------------
+
+
+# ---------------------------------------------------------------------------
+# Compensated arithmetic for alpha = 2/r - v^2/mu
+# ---------------------------------------------------------------------------
+# Near-parabolic states have 2/r and v^2/mu nearly equal, so plain floating
+# point leaves alpha (= 1/a) with a relative error of eps * (2/r) / |alpha| --
+# 4e-12 at e = 0.99 near periapsis.  That error becomes a period error, and
+# the phase drifts by it every orbit.  Computing alpha in double-double
+# (error-free transformations: Knuth's TwoSum, Dekker's split/TwoProduct,
+# Ogita, Rump & Oishi 2005 "Accurate sum and dot product") makes it correct
+# to a few ulps of alpha itself, so the only loss left is the input's own
+# rounding.  No FMA is needed, which keeps this portable under numba.
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _two_sum(a, b):
+    s = a + b
+    bb = s - a
+    return s, (a - (s - bb)) + (b - bb)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _two_prod(a, b):
+    p = a * b
+    c = 134217729.0 * a  # 2^27 + 1: Dekker's splitter for doubles
+    ah = c - (c - a)
+    al = a - ah
+    c = 134217729.0 * b
+    bh = c - (c - b)
+    bl = b - bh
+    return p, ((ah * bh - p) + ah * bl + al * bh) + al * bl
+
+
+@njit(cache=True, error_model="numpy")
+def _state_scalars(r0, v0, mu):
+    """``(|r0|, |v0|^2, r0.v0, alpha)`` with alpha = 2/|r0| - |v0|^2/mu
+    accurate to a few ulps (double-double intermediates)."""
+    rh = 0.0
+    rl = 0.0
+    vh = 0.0
+    vl = 0.0
+    dh = 0.0
+    dl = 0.0
+    for i in range(r0.shape[0]):
+        p, e = _two_prod(r0[i], r0[i])
+        rh, t = _two_sum(rh, p)
+        rl += t + e
+        p, e = _two_prod(v0[i], v0[i])
+        vh, t = _two_sum(vh, p)
+        vl += t + e
+        p, e = _two_prod(r0[i], v0[i])
+        dh, t = _two_sum(dh, p)
+        dl += t + e
+    rh, rl = _two_sum(rh, rl)
+    vh, vl = _two_sum(vh, vl)
+    # |r| = sqrt(rh + rl) to double-double: one Newton correction.
+    sh = math.sqrt(rh)
+    p, e = _two_prod(sh, sh)
+    sl = ((rh - p) - e + rl) / (2.0 * sh)
+    # 2/|r| to double-double.
+    qh = 2.0 / sh
+    p, e = _two_prod(qh, sh)
+    ql = (((2.0 - p) - e) - qh * sl) / sh
+    # |v|^2/mu to double-double.
+    wh = vh / mu
+    p, e = _two_prod(wh, mu)
+    wl = (((vh - p) - e) + vl) / mu
+    a, err = _two_sum(qh, -wh)
+    alpha = a + (err + (ql - wl))
+    return sh, vh + vl, dh + dl, alpha
 
 
 @njit(cache=True, error_model="numpy")
@@ -143,6 +217,19 @@ def _universal_functions(chi, alpha):
 
 
 @njit(cache=True, error_model="numpy")
+def _kepler_residual(y, r0n, sig, alpha, target):
+    """Residual G of Kepler's equation at chi = y, its derivative r, and the
+    rounding-noise level of G (eps times the sum of its terms' magnitudes)."""
+    u0, u1, u2, u3 = _universal_functions(y, alpha)
+    a1 = r0n * u1
+    a2 = sig * u2
+    G = a1 + a2 + u3 - target
+    r = r0n * u0 + sig * u1 + u2
+    noise = _RESIDUAL_RTOL * (abs(a1) + abs(a2) + abs(u3) + target)
+    return G, r, noise
+
+
+@njit(cache=True, error_model="numpy")
 def universal_anomaly(r0n, sigma0, alpha, tau):
     """Solve the universal Kepler equation for the universal anomaly chi.
 
@@ -150,19 +237,22 @@ def universal_anomaly(r0n, sigma0, alpha, tau):
     eq. 4.84), where ``tau = sqrt(mu) t``, ``sigma0 = (r0 . v0) / sqrt(mu)``,
     ``alpha = 2/r0n - v0^2/mu`` and U_k are Battin's universal functions.
     The right-hand side is monotonic in chi with derivative ``r(chi) =
-    r0n U0 + sigma0 U1 + U2 >= 0``, so the root is unique and is found by
-    Newton's method kept inside a bracket: whenever the Newton step leaves
-    the bracket or fails to halve it fast enough, a bisection step is taken
-    instead (Press et al. 2007, sec. 9.4, "rtsafe").  This always converges,
-    including for nearly parabolic and radial orbits.
+    r0n U0 + sigma0 U1 + U2 >= 0``, so the root is unique.
+
+    The guess (Vallado 2013, algorithm 8: ``alpha tau`` for ellipses, a
+    logarithmic estimate for hyperbolae; plus ``tau / r0n`` for short arcs
+    and ``(6 tau)^(1/3)`` near parabolic) is doubled or halved until the root
+    is bracketed within a factor of two; for ellipses the bracket is also
+    capped by one period, ``chi = 2 pi / sqrt(alpha)``.  Newton's method then
+    runs inside the bracket, and whenever its step leaves the bracket or fails
+    to halve it fast enough a bisection step is taken instead (Press et al.
+    2007, sec. 9.4, "rtsafe").  It stops when the step or the residual reaches
+    rounding level.  This always converges, including for nearly parabolic
+    and radial orbits; typically 4-8 evaluations, rarely more than ~20.
 
     For elliptic orbits ``tau`` should already be reduced to within half a
-    period (``lagrange_coefficients`` does this); ``chi`` then lies within
-    one period ``2 pi / sqrt(alpha)`` which bounds the bracket.
-
-    Initial guesses follow Vallado (2013, algorithm 8): ``alpha tau`` for
-    ellipses (exact for circles) and the logarithmic estimate for
-    hyperbolae, with ``min(tau / r0n, cbrt(6 tau))`` as the fallback.
+    period (``lagrange_coefficients`` does this).  ``r0n`` may be 0 (start at
+    the focus of a radial orbit).
     """
     if tau == 0.0:
         return 0.0
@@ -176,7 +266,6 @@ def universal_anomaly(r0n, sigma0, alpha, tau):
     y = -1.0
     if alpha > 0.0:
         hi = _TWO_PI / math.sqrt(alpha)  # one full period: tau(hi) = 2pi/alpha^1.5
-        y = target * alpha
     else:
         hi = np.inf
         if alpha < 0.0:
@@ -186,8 +275,15 @@ def universal_anomaly(r0n, sigma0, alpha, tau):
                 arg = -2.0 * alpha * target / den
                 if arg > 1.0:
                     y = sqa * math.log(arg)
+                    if r0n > 0.0:
+                        # The log form is for long arcs; it overshoots short ones.
+                        y = min(y, target / r0n)
     if not (0.0 < y < hi):
+        # Short arcs: chi ~ tau / r0.  Long arcs: mean motion (alpha tau) on
+        # ellipses, the cubic term (6 tau)^(1/3) on near-parabolic orbits.
         y = np.cbrt(6.0 * target)
+        if alpha > 0.0:
+            y = max(y, target * alpha)
         if r0n > 0.0:
             y = min(y, target / r0n)
         if not (y < hi):
@@ -196,29 +292,46 @@ def universal_anomaly(r0n, sigma0, alpha, tau):
         # target so small that chi underflows: the state does not move.
         return 0.0
 
-    u0, u1, u2, u3 = _universal_functions(y, alpha)
-    G = r0n * u1 + sig * u2 + u3 - target
-    r = r0n * u0 + sig * u1 + u2
-    if G == 0.0:
+    G, r, noise = _kepler_residual(y, r0n, sig, alpha, target)
+    if abs(G) <= noise:
         return d * y
+    # Bracket the root within a factor of two by doubling or halving the
+    # guess, remembering the endpoint with the smaller residual as the
+    # Newton start (a good guess is not thrown away).
+    yb, Gb, rb = y, G, r
     if G < 0.0:
         lo = y
-    else:  # positive, or nan from overflow far beyond the root
-        hi = y
-
-    if hi == np.inf:
-        # Unbounded orbit and the guess fell short: double until we pass the
-        # root (tau grows at least cubically in chi here, so this is short).
         for _ in range(2100):
-            y = 2.0 * y
-            u0, u1, u2, u3 = _universal_functions(y, alpha)
-            G = r0n * u1 + sig * u2 + u3 - target
-            r = r0n * u0 + sig * u1 + u2
+            y2 = 2.0 * y
+            if not (y2 < hi):
+                break
+            y = y2
+            G, r, noise = _kepler_residual(y, r0n, sig, alpha, target)
+            if not (abs(G) >= abs(Gb)):  # smaller, or nan (never chosen)
+                if abs(G) < abs(Gb):
+                    yb, Gb, rb = y, G, r
             if G < 0.0:
                 lo = y
-            else:
+            else:  # positive, or nan from overflow far beyond the root
                 hi = y
                 break
+    else:
+        hi = y
+        for _ in range(2100):
+            y2 = 0.5 * y
+            if not (y2 > 0.0):
+                break
+            y = y2
+            G, r, noise = _kepler_residual(y, r0n, sig, alpha, target)
+            if abs(G) < abs(Gb) or not (abs(Gb) < np.inf):
+                yb, Gb, rb = y, G, r
+            if G < 0.0:
+                lo = y
+                break
+            hi = y
+    y, G, r = yb, Gb, rb
+    if G == 0.0:
+        return d * y
 
     dx_old = hi - lo
     dx = dx_old
@@ -238,16 +351,15 @@ def universal_anomaly(r0n, sigma0, alpha, tau):
             y = yn
             break
         y = yn
-        u0, u1, u2, u3 = _universal_functions(y, alpha)
-        G = r0n * u1 + sig * u2 + u3 - target
-        r = r0n * u0 + sig * u1 + u2
+        G, r, noise = _kepler_residual(y, r0n, sig, alpha, target)
         if G < 0.0:
             lo = y
         elif G == 0.0:
             break
         else:
             hi = y
-        if hi - lo <= 2.3e-16 * hi:
+        # Further Newton steps would only chase rounding noise.
+        if abs(G) <= noise or hi - lo <= 2.3e-16 * hi:
             break
     return d * y
 
@@ -273,18 +385,9 @@ def lagrange_coefficients(r0, v0, mu, t):
 
     ``r0`` and ``v0`` are float arrays of equal length (2 or 3), ``mu > 0``.
     """
-    n = r0.shape[0]
-    r0n2 = 0.0
-    v02 = 0.0
-    rv = 0.0
-    for i in range(n):
-        r0n2 += r0[i] * r0[i]
-        v02 += v0[i] * v0[i]
-        rv += r0[i] * v0[i]
-    r0n = math.sqrt(r0n2)
+    r0n, v02, rv, alpha = _state_scalars(r0, v0, mu)
     sqmu = math.sqrt(mu)
     sigma0 = rv / sqmu
-    alpha = 2.0 / r0n - v02 / mu
 
     if alpha > 0.0:
         period = _TWO_PI / (sqmu * alpha * math.sqrt(alpha))
@@ -305,10 +408,11 @@ def lagrange_coefficients(r0, v0, mu, t):
     return f, g, fdot, gdot
 
 
-# An unbound state farther than this many periapsis distances from the focus
-# is propagated from periapsis instead of from itself (see kepler_step).  Below
-# it the hyperbolic anomaly |H0| < 1.4 (parabolic anomaly tan(nu/2) < 1), so
-# the direct universal form loses at most a factor e^(2|H0|) ~ 16.
+# A state farther than this many periapsis distances from the focus is
+# propagated from periapsis instead of from itself (see kepler_step).  Nearer
+# in, the hyperbolic anomaly |H0| < 1.4 (parabolic anomaly tan(nu/2) < 1), so
+# the direct universal form loses at most a factor e^(2|H0|) ~ 16; ellipses
+# this far out have e > 1/3, so the periapsis direction is well defined.
 _FAR_FROM_PERIAPSIS = 2.0
 
 
@@ -319,97 +423,104 @@ def kepler_step(r0, v0, mu, t, r_out, v_out):
     Same physics as :func:`kepler`; no validation.  ``r_out``/``v_out`` may be
     the very arrays ``r0``/``v0`` (in-place update for a game loop).
 
-    Bound states, and unbound ones near periapsis, use the Lagrange
-    coefficients of :func:`lagrange_coefficients`.  Unbound (hyperbolic or
-    parabolic) states far out (``|r0| > 2 q``) are handled differently: from
-    there U1..U3 grow like ``e^|dH|`` (or ``chi^3``), and the terms of both
-    Kepler's equation and ``r = f r0 + g v0`` cancel to a tiny fraction of
-    their size -- a flyby started 1e4 |a| out loses ~8 digits.  Such orbits
-    are re-expressed about periapsis, where ``sigma = 0`` and nothing cancels.
-    With ``p = h^2/mu``, ``e = sqrt(1 - alpha p)``, ``q = p / (1 + e)``,
-    ``P = e_vec / |e_vec|``, ``Q = h x P / |h|`` (Bate, Mueller & White 1971,
-    ch. 2 and 4; Battin 1999, sec. 4.5)::
+    States near periapsis (``|r0| <= 2 q``) use the Lagrange coefficients of
+    :func:`lagrange_coefficients`.  Farther out that form is ill-conditioned
+    on open and near-parabolic orbits: U1..U3 grow like ``e^|dH|`` (or
+    ``chi^3``) and the terms of both Kepler's equation and ``r = f r0 + g v0``
+    cancel to a tiny fraction of their size -- a hyperbolic flyby started
+    1e4 |a| out would lose ~8 digits.  Such states are re-expressed about
+    periapsis, where ``sigma = 0`` and nothing cancels.  With ``p = h^2/mu``,
+    ``e = sqrt(1 - alpha p)``, ``q = p / (1 + e)``, ``P = e_vec / |e_vec|``,
+    ``Q = h x P / |h|`` (Bate, Mueller & White 1971, ch. 2 and 4; Battin
+    1999, sec. 4.5)::
 
-        U1(chi_p) = sigma0 / (1 - alpha q)          (state's anomaly from q)
+        chi_p: the state's universal anomaly measured from periapsis,
+               E0 / sqrt(alpha), H0 / sqrt(-alpha) or sigma0 (parabola), from
+               U0(chi_p) = (1 - alpha r0) / e,  U1(chi_p) = sigma0 / e
         sqrt(mu) t_p = q U1(chi_p) + U3(chi_p)      (time since periapsis)
         sqrt(mu) (t_p + t) = q U1(chi) + U3(chi),   r = q U0 + U2
         r_vec = (q - U2) P + (h U1 / sqrt(mu)) Q
         v_vec = -(sqrt(mu) U1 / r) P + (h U0 / r) Q
 
-    ``chi_p = asinh(sqrt(-alpha) U1) / sqrt(-alpha)`` (``= U1`` for a
-    parabola).  Errors then stay at the level set by rounding of the input.
-    A radial orbit (``h = 0``, ``q = 0``) passes through the focus at
-    ``t_p = 0`` and is continued as a bounce, like the bound radial case.
+    (For a parabola ``e = 1``.)  Both terms of ``t_p`` carry the sign of
+    ``chi_p``, so nothing cancels, and errors stay at the level set by the
+    rounding of the input itself.  A radial orbit (``h = 0``, ``q = 0``)
+    reaches the focus at ``t_p = 0`` and is continued as a bounce.
     """
     n = r0.shape[0]
-    r0n2 = 0.0
-    v02 = 0.0
-    rv = 0.0
-    for i in range(n):
-        r0n2 += r0[i] * r0[i]
-        v02 += v0[i] * v0[i]
-        rv += r0[i] * v0[i]
-    r0n = math.sqrt(r0n2)
-    alpha = 2.0 / r0n - v02 / mu
-    if alpha <= 0.0:
-        if n == 3:
-            hx = r0[1] * v0[2] - r0[2] * v0[1]
-            hy = r0[2] * v0[0] - r0[0] * v0[2]
-            hz = r0[0] * v0[1] - r0[1] * v0[0]
+    r0n, v02, rv, alpha = _state_scalars(r0, v0, mu)
+    if n == 3:
+        hx = r0[1] * v0[2] - r0[2] * v0[1]
+        hy = r0[2] * v0[0] - r0[0] * v0[2]
+        hz = r0[0] * v0[1] - r0[1] * v0[0]
+    else:
+        hx = 0.0
+        hy = 0.0
+        hz = r0[0] * v0[1] - r0[1] * v0[0]
+    h2 = hx * hx + hy * hy + hz * hz
+    # e^2 = 1 - alpha p: exact enough wherever it is used (e > 1/3 below).
+    e = math.sqrt(max(0.0, 1.0 - alpha * h2 / mu))
+    q = h2 / (mu * (1.0 + e))
+    if r0n > _FAR_FROM_PERIAPSIS * q:
+        h = math.sqrt(h2)
+        sqmu = math.sqrt(mu)
+        sigma0 = rv / sqmu
+        if alpha > 0.0:
+            sa = math.sqrt(alpha)
+            chip = math.atan2(sa * sigma0, 1.0 - alpha * r0n) / sa
+        elif alpha < 0.0:
+            sa = math.sqrt(-alpha)
+            y = sa * sigma0 / e
+            chip = math.asinh(y) / sa if y != 0.0 else sigma0 / e
         else:
-            hx = 0.0
-            hy = 0.0
-            hz = r0[0] * v0[1] - r0[1] * v0[0]
-        h2 = hx * hx + hy * hy + hz * hz
-        # e^2 = 1 - alpha p has no cancellation for alpha <= 0, unlike |e_vec|.
-        e = math.sqrt(1.0 - alpha * h2 / mu)
-        q = h2 / (mu * (1.0 + e))
-        if r0n > _FAR_FROM_PERIAPSIS * q:
-            h = math.sqrt(h2)
-            sqmu = math.sqrt(mu)
-            u1p = rv / sqmu / (1.0 - alpha * q)
-            chip = u1p
-            if alpha < 0.0:
-                sa = math.sqrt(-alpha)
-                y = sa * u1p
-                if y != 0.0:
-                    chip = math.asinh(y) / sa
-            _, _, _, u3p = _universal_functions(chip, alpha)
-            # Both terms have the sign of chip: the sum cannot cancel.
-            tau = (q * u1p + u3p) + sqmu * t
-            chi = universal_anomaly(q, 0.0, alpha, tau)
-            u0, u1, u2, u3 = _universal_functions(chi, alpha)
-            r = q * u0 + u2
-            xp = q - u2
-            yq = h * u1 / sqmu
-            vp = -sqmu * u1 / r
-            vq = h * u0 / r
-            k = v02 - mu / r0n
-            ex = k * r0[0] - rv * v0[0]  # mu * e_vec; only its direction is used
-            ey = k * r0[1] - rv * v0[1]
-            ez = k * r0[2] - rv * v0[2] if n == 3 else 0.0
-            en = math.sqrt(ex * ex + ey * ey + ez * ez)
-            px = ex / en
-            py = ey / en
-            pz = ez / en
-            if h > 0.0:
-                qx = (hy * pz - hz * py) / h
-                qy = (hz * px - hx * pz) / h
-                qz = (hx * py - hy * px) / h
-            else:
-                # Radial: no Q direction, and yq = vq = 0 anyway.
-                qx = 0.0
-                qy = 0.0
-                qz = 0.0
-            # All reads of r0/v0 are done, so writing aliased outputs is safe.
-            r_out[0] = xp * px + yq * qx
-            r_out[1] = xp * py + yq * qy
-            v_out[0] = vp * px + vq * qx
-            v_out[1] = vp * py + vq * qy
-            if n == 3:
-                r_out[2] = xp * pz + yq * qz
-                v_out[2] = vp * pz + vq * qz
-            return
+            chip = sigma0
+        _, u1p, _, u3p = _universal_functions(chip, alpha)
+        tau = q * u1p + u3p  # sqrt(mu) * time since periapsis
+        if alpha > 0.0:
+            period = _TWO_PI / (sqmu * alpha * math.sqrt(alpha))
+            if abs(t) > 0.5 * period:
+                t = np.fmod(t, period)  # exact
+            tau += sqmu * t
+            half = 0.5 * sqmu * period
+            if tau > half:
+                tau -= 2.0 * half
+            elif tau < -half:
+                tau += 2.0 * half
+        else:
+            tau += sqmu * t
+        chi = universal_anomaly(q, 0.0, alpha, tau)
+        u0, u1, u2, u3 = _universal_functions(chi, alpha)
+        r = q * u0 + u2
+        xp = q - u2
+        yq = h * u1 / sqmu
+        vp = -sqmu * u1 / r
+        vq = h * u0 / r
+        k = v02 - mu / r0n
+        ex = k * r0[0] - rv * v0[0]  # mu * e_vec; only its direction is used
+        ey = k * r0[1] - rv * v0[1]
+        ez = k * r0[2] - rv * v0[2] if n == 3 else 0.0
+        en = math.sqrt(ex * ex + ey * ey + ez * ez)
+        px = ex / en
+        py = ey / en
+        pz = ez / en
+        if h > 0.0:
+            qx = (hy * pz - hz * py) / h
+            qy = (hz * px - hx * pz) / h
+            qz = (hx * py - hy * px) / h
+        else:
+            # Radial: no Q direction, and yq = vq = 0 anyway.
+            qx = 0.0
+            qy = 0.0
+            qz = 0.0
+        # All reads of r0/v0 are done, so writing aliased outputs is safe.
+        r_out[0] = xp * px + yq * qx
+        r_out[1] = xp * py + yq * qy
+        v_out[0] = vp * px + vq * qx
+        v_out[1] = vp * py + vq * qy
+        if n == 3:
+            r_out[2] = xp * pz + yq * qz
+            v_out[2] = vp * pz + vq * qz
+        return
     f, g, fdot, gdot = lagrange_coefficients(r0, v0, mu, t)
     for i in range(n):
         # Read both components before writing, so aliasing is safe.
@@ -448,23 +559,19 @@ def kepler_propagate_times(r0, v0, mu, times):
 def orbit_invariants(r0, v0, mu):
     """Conic invariants ``(a, e, energy, period, h, p, periapsis)``.
 
-    ``energy = v^2/2 - mu/r``, ``a = -mu / (2 energy)`` (``inf`` for a
-    parabola, negative for a hyperbola), ``h = |r x v|``, semi-latus rectum
-    ``p = h^2/mu``, eccentricity from the Laplace-Runge-Lenz vector
-    ``e = ((v^2 - mu/r) r - (r.v) v) / mu``, periapsis distance
-    ``q = p / (1 + e)``, and ``period = 2 pi sqrt(a^3/mu)`` for bound orbits
-    (``inf`` otherwise).  Bate, Mueller & White 1971, ch. 1 and 2.
+    ``energy = v^2/2 - mu/r = -mu alpha / 2`` with ``alpha = 1/a`` computed
+    in compensated arithmetic (see ``_state_scalars``), ``a = 1/alpha``
+    (``inf`` for a parabola, negative for a hyperbola), ``h = |r x v|``,
+    semi-latus rectum ``p = h^2/mu``, eccentricity from the
+    Laplace-Runge-Lenz vector ``e = |(v^2 - mu/r) r - (r.v) v| / mu``,
+    periapsis distance ``q = p / (1 + e)``, and ``period = 2 pi /
+    (sqrt(mu) alpha^1.5) = 2 pi sqrt(a^3/mu)`` for bound orbits (``inf``
+    otherwise) -- the same period ``kepler`` reduces time with.  Bate,
+    Mueller & White 1971, ch. 1 and 2.
     """
     n = r0.shape[0]
-    rr = 0.0
-    vv = 0.0
-    rv = 0.0
-    for i in range(n):
-        rr += r0[i] * r0[i]
-        vv += v0[i] * v0[i]
-        rv += r0[i] * v0[i]
-    rn = math.sqrt(rr)
-    energy = 0.5 * vv - mu / rn
+    rn, vv, rv, alpha = _state_scalars(r0, v0, mu)
+    energy = -0.5 * mu * alpha
     if n == 3:
         hx = r0[1] * v0[2] - r0[2] * v0[1]
         hy = r0[2] * v0[0] - r0[0] * v0[2]
@@ -479,12 +586,12 @@ def orbit_invariants(r0, v0, mu):
         e2 += ei * ei
     e = math.sqrt(e2)
     p = h * h / mu
-    if energy != 0.0:
-        a = -mu / (2.0 * energy)
+    if alpha != 0.0:
+        a = 1.0 / alpha
     else:
         a = np.inf
-    if energy < 0.0:
-        period = _TWO_PI * math.sqrt(a * a * a / mu)
+    if alpha > 0.0:
+        period = _TWO_PI / (math.sqrt(mu) * alpha * math.sqrt(alpha))
     else:
         period = np.inf
     return a, e, energy, period, h, p, p / (1.0 + e)

@@ -11,9 +11,9 @@ import math
 
 from numba import njit
 
-from ._kernels import add_force, delta
+from ._kernels import add_force, delta_periodic
 from .base import Force, floats, EMPTY_INTS
-from .._validate import nonnegative_float, finite_float
+from .._validate import nonnegative_float, finite_float, positive_float
 
 KIND = 3
 
@@ -23,6 +23,7 @@ def accumulate(t, pos, vel, prm, n, fp, ip, acc):
     mass, charge, _, active, _ = prm
     k = fp[0]
     eps2 = fp[1]
+    box = fp[2]
     dim = pos.shape[0]
     for i in range(n):
         if not active[i] or charge[i] == 0.0:
@@ -30,7 +31,7 @@ def accumulate(t, pos, vel, prm, n, fp, ip, acc):
         for j in range(i + 1, n):
             if not active[j] or charge[j] == 0.0:
                 continue
-            dx, dy, dz = delta(pos, i, j, dim)
+            dx, dy, dz = delta_periodic(pos, i, j, dim, box)
             r2 = dx * dx + dy * dy + dz * dz + eps2
             s = k * charge[i] * charge[j] / (r2 * math.sqrt(r2))
             # force on i is -s d (repulsion for s > 0); on j it is +s d
@@ -43,6 +44,7 @@ def potential(t, pos, vel, prm, n, fp, ip):
     _, charge, _, active, _ = prm
     k = fp[0]
     eps2 = fp[1]
+    box = fp[2]
     dim = pos.shape[0]
     u = 0.0
     for i in range(n):
@@ -51,24 +53,28 @@ def potential(t, pos, vel, prm, n, fp, ip):
         for j in range(i + 1, n):
             if not active[j] or charge[j] == 0.0:
                 continue
-            dx, dy, dz = delta(pos, i, j, dim)
+            dx, dy, dz = delta_periodic(pos, i, j, dim, box)
             u += k * charge[i] * charge[j] / math.sqrt(dx * dx + dy * dy + dz * dz + eps2)
     return u
 
 
 class Coulomb(Force):
-    """Coulomb forces between all charged active particles; ``k`` is the Coulomb constant."""
+    """Coulomb forces between all charged active particles; ``k`` is the Coulomb constant.
+
+    ``box``: side of a periodic (torus) domain; pairs then interact through their nearest image.
+    """
 
     KIND = KIND
     conservative = True
 
-    def __init__(self, k=1.0, softening=0.0):
+    def __init__(self, k=1.0, softening=0.0, box=None):
         super().__init__()
         self.k = finite_float("k", k)
         self.softening = nonnegative_float("softening", softening)
+        self.box = None if box is None else positive_float("box", box)
 
     def _pack(self, sim):
-        return floats(self.k, self.softening ** 2), EMPTY_INTS
+        return floats(self.k, self.softening ** 2, self.box or 0.0), EMPTY_INTS
 
     def __repr__(self):
         return f"Coulomb(k={self.k!r}, softening={self.softening!r})"

@@ -12,9 +12,9 @@ import math
 
 from numba import njit
 
-from ._kernels import delta
+from ._kernels import delta_periodic
 from .base import Force, floats, EMPTY_INTS
-from .._validate import nonnegative_float
+from .._validate import nonnegative_float, positive_float
 
 KIND = 0
 
@@ -24,6 +24,7 @@ def accumulate(t, pos, vel, prm, n, fp, ip, acc):
     mass, _, _, active, test = prm
     G = fp[0]
     eps2 = fp[1]
+    box = fp[2]
     dim = pos.shape[0]
     for i in range(n):
         if not active[i]:
@@ -33,7 +34,7 @@ def accumulate(t, pos, vel, prm, n, fp, ip, acc):
             if not active[j] or (test[i] and test[j]):
                 continue
             gj = 0.0 if test[j] else G * mass[j]
-            dx, dy, dz = delta(pos, i, j, dim)
+            dx, dy, dz = delta_periodic(pos, i, j, dim, box)
             r2 = dx * dx + dy * dy + dz * dz + eps2
             inv_r3 = 1.0 / (r2 * math.sqrt(r2))
             # Coincident bodies without softening give 0 * inf = nan: the step then fails loudly.
@@ -53,6 +54,7 @@ def potential(t, pos, vel, prm, n, fp, ip):
     mass, _, _, active, test = prm
     G = fp[0]
     eps2 = fp[1]
+    box = fp[2]
     dim = pos.shape[0]
     u = 0.0
     for i in range(n):
@@ -61,7 +63,7 @@ def potential(t, pos, vel, prm, n, fp, ip):
         for j in range(i + 1, n):
             if not active[j] or test[j]:
                 continue
-            dx, dy, dz = delta(pos, i, j, dim)
+            dx, dy, dz = delta_periodic(pos, i, j, dim, box)
             u -= G * mass[i] * mass[j] / math.sqrt(dx * dx + dy * dy + dz * dz + eps2)
     return u
 
@@ -71,19 +73,21 @@ class NBodyGravity(Force):
 
     ``G=None`` uses the simulation's ``G`` (1.0 without units). ``softening`` is the Plummer
     length eps >= 0; with eps = 0 two coincident bodies make the step raise SimulationError.
+    ``box``: side of a periodic (torus) domain; pairs then interact through their nearest image.
     """
 
     KIND = KIND
     conservative = True
 
-    def __init__(self, G=None, softening=0.0):
+    def __init__(self, G=None, softening=0.0, box=None):
         super().__init__()
         self.G = None if G is None else nonnegative_float("G", G)
         self.softening = nonnegative_float("softening", softening)
+        self.box = None if box is None else positive_float("box", box)
 
     def _pack(self, sim):
         G = sim.G if self.G is None else self.G
-        return floats(G, self.softening ** 2), EMPTY_INTS
+        return floats(G, self.softening ** 2, self.box or 0.0), EMPTY_INTS
 
     def __repr__(self):
         return f"NBodyGravity(G={self.G!r}, softening={self.softening!r})"

@@ -11,11 +11,17 @@ import math
 from numba import njit
 
 from .base import Force, EMPTY_INTS
-from .._validate import positive_float, nonnegative_float, vector, finite_float
+from .._validate import positive_float, nonnegative_float, vector
 
 import numpy as np
 
 KIND = 1
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _target(ip, n, k):
+    """The k-th particle the attractor acts on: every particle, or only those listed in ip."""
+    return k if ip.shape[0] == 0 else ip[k]
 
 
 @njit(cache=True, error_model="numpy")
@@ -27,8 +33,9 @@ def accumulate(t, pos, vel, prm, n, fp, ip, acc):
     cx = fp[2]
     cy = fp[3]
     cz = fp[4] if dim == 3 else 0.0
-    for i in range(n):
-        if not active[i]:
+    for k in range(n if ip.shape[0] == 0 else ip.shape[0]):
+        i = _target(ip, n, k)
+        if i >= n or not active[i]:
             continue
         dx = pos[0, i] - cx
         dy = pos[1, i] - cy
@@ -49,8 +56,9 @@ def potential(t, pos, vel, prm, n, fp, ip):
     eps2 = fp[1]
     dim = pos.shape[0]
     u = 0.0
-    for i in range(n):
-        if not active[i]:
+    for j in range(n if ip.shape[0] == 0 else ip.shape[0]):
+        i = _target(ip, n, j)
+        if i >= n or not active[i]:
             continue
         r2 = eps2
         for k in range(dim):
@@ -61,16 +69,29 @@ def potential(t, pos, vel, prm, n, fp, ip):
 
 
 class PointMass(Force):
-    """Fixed attractor of gravitational parameter ``mu`` (= G M) at ``pos``."""
+    """Fixed attractor of gravitational parameter ``mu`` (= G M) at ``pos``.
+
+    ``particles``: the indices it acts on (default: every particle), e.g. Spacewar's star pulls
+    the ships but not the (weightless) torpedoes.
+    """
 
     KIND = KIND
     conservative = True
 
-    def __init__(self, mu=1.0, pos=(0.0, 0.0), softening=0.0):
+    def __init__(self, mu=1.0, pos=(0.0, 0.0), softening=0.0, particles=None):
         super().__init__()
         self._mu = positive_float("mu", mu)
         self._pos = vector("pos", pos)
         self.softening = nonnegative_float("softening", softening)
+        if particles is None:
+            self.particles = EMPTY_INTS
+        else:
+            try:
+                self.particles = np.array(particles, dtype=np.int64).reshape(-1)
+            except (TypeError, ValueError, OverflowError):
+                raise TypeError(f"particles must be particle indices, got {particles!r}") from None
+            if self.particles.size == 0:
+                raise ValueError("particles must list at least one index (None means all)")
 
     @property
     def mu(self):
@@ -95,9 +116,14 @@ class PointMass(Force):
         if self._pos.shape[0] != sim.dim:
             raise ValueError(f"PointMass pos must have length {sim.dim} (the simulation's dim), "
                              f"got {tuple(self._pos)}")
+        bad = (self.particles < 0) | (self.particles >= sim.n)
+        if np.any(bad):
+            k = int(np.flatnonzero(bad)[0])
+            raise ValueError(f"particles[{k}] = {self.particles[k]} is out of range "
+                             f"(the simulation has {sim.n} particles)")
 
     def _pack(self, sim):
-        return np.concatenate(([self._mu, self.softening ** 2], self._pos)), EMPTY_INTS
+        return np.concatenate(([self._mu, self.softening ** 2], self._pos)), self.particles.copy()
 
     def __repr__(self):
         return f"PointMass(mu={self._mu!r}, pos={tuple(self._pos)!r}, softening={self.softening!r})"

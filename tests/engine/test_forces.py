@@ -283,3 +283,26 @@ def test_rope_and_cloth_helpers():
     # a flat 2 x 2 sheet facing the wind takes force |area| |w| = 4 in total
     total = (accel(sim) * sim.mass[:, None]).sum(axis=0)
     np.testing.assert_allclose(total, (0, 0, 4.0), rtol=1e-12)
+
+
+def test_point_mass_acts_only_on_listed_particles():
+    sim = Simulation(dim=2)
+    sim.add_many(mass=1.0, pos=[(1.0, 0.0), (0.0, 2.0), (3.0, 0.0)])
+    sim.add_force(forces.PointMass(mu=4.0, particles=[0, 2]))
+    a = accel(sim)
+    np.testing.assert_allclose(a, [(-4.0, 0.0), (0.0, 0.0), (-4.0 / 9.0, 0.0)])
+    assert sim.potential_energy() == pytest.approx(-4.0 - 4.0 / 3.0)
+    with pytest.raises(ValueError, match=r"particles\[0\] = 5 is out of range"):
+        Simulation().add_force(forces.PointMass(particles=[5]))
+
+
+@pytest.mark.parametrize("make", [lambda: forces.NBodyGravity(box=10.0),
+                                  lambda: forces.Coulomb(k=-1.0, box=10.0)])
+def test_periodic_box_uses_the_nearest_image(make):
+    # bodies at x = -4.5 and x = 4.5 on a torus of side 10 are 1 apart through the edge
+    sim = Simulation(dim=2)
+    sim.add_many(mass=1.0, pos=[(-4.5, 0.0), (4.5, 0.0)], charge=1.0)
+    sim.add_force(make())
+    a = accel(sim)
+    np.testing.assert_allclose(a, [(-1.0, 0.0), (1.0, 0.0)], rtol=1e-14)
+    assert sim.potential_energy() == pytest.approx(-1.0)
