@@ -1,0 +1,92 @@
+"""Bots: built-in ones by name, others by ``package.module:Class`` or ``path/to/file.py:Class``.
+
+A bot is any class with ``act(self, obs) -> spacewar.Action``; it may define ``reset(self)``
+(called when a match starts) and accept a ``seed`` keyword (built-in bots do).
+"""
+import importlib
+import importlib.util
+import inspect
+import os
+import sys
+
+#: name -> "module:Class" of the built-in bots
+BUILTIN = {
+    "idle": "spacewar.bots.idle:Idle",
+    "random": "spacewar.bots.random_bot:RandomBot",
+    "chaser": "spacewar.bots.chaser:Chaser",
+    "sniper": "spacewar.bots.sniper:Sniper",
+    "dodger": "spacewar.bots.dodger:Dodger",
+}
+
+
+class BotLoadError(ValueError):
+    """A bot specification that cannot be loaded (the message says why)."""
+
+
+def available():
+    """Names of the built-in bots."""
+    return sorted(BUILTIN)
+
+
+def is_builtin(spec):
+    return spec in BUILTIN
+
+
+def _import_from_file(path, class_name):
+    if not os.path.isfile(path):
+        raise BotLoadError(f"bot file {path!r} does not exist")
+    module_name = "spacewar_user_bot_" + str(abs(hash(os.path.abspath(path))))
+    module = sys.modules.get(module_name)
+    if module is None:
+        spec = importlib.util.spec_from_file_location(module_name, path)
+        if spec is None or spec.loader is None:
+            raise BotLoadError(f"cannot import bot file {path!r}")
+        module = importlib.util.module_from_spec(spec)
+        sys.modules[module_name] = module
+        try:
+            spec.loader.exec_module(module)
+        except Exception as exc:
+            del sys.modules[module_name]
+            raise BotLoadError(f"importing {path!r} failed: {type(exc).__name__}: {exc}") from exc
+    return getattr(module, class_name, None), path
+
+
+def load_bot_class(spec):
+    """The bot class named by ``spec`` (a built-in name, ``module:Class`` or ``file.py:Class``)."""
+    if not isinstance(spec, str) or not spec:
+        raise BotLoadError(f"bot must be a name or 'module:Class' string, got {spec!r}")
+    target = BUILTIN.get(spec, spec)
+    if ":" not in target:
+        raise BotLoadError(f"unknown bot {spec!r}; available: {', '.join(available())} "
+                           "(or give package.module:Class or path/to/file.py:Class)")
+    where, class_name = target.rsplit(":", 1)
+    if where.endswith(".py") or os.sep in where or "/" in where:
+        cls, origin = _import_from_file(where, class_name)
+    else:
+        try:
+            module = importlib.import_module(where)
+        except ImportError as exc:
+            raise BotLoadError(f"cannot import module {where!r} for bot {spec!r}: {exc}") from exc
+        except Exception as exc:
+            raise BotLoadError(f"importing {where!r} failed: {type(exc).__name__}: {exc}") from exc
+        cls, origin = getattr(module, class_name, None), where
+    if cls is None:
+        raise BotLoadError(f"{origin!r} has no class {class_name!r}")
+    if not callable(getattr(cls, "act", None)):
+        raise BotLoadError(f"{spec!r} is not a bot: it has no act(self, obs) method")
+    return cls
+
+
+def make_bot(spec, seed=None):
+    """An instance of the bot ``spec``, given ``seed`` if its constructor takes one."""
+    cls = load_bot_class(spec)
+    try:
+        params = inspect.signature(cls).parameters
+    except (TypeError, ValueError):
+        params = {}
+    try:
+        if "seed" in params:
+            return cls(seed=seed)
+        return cls()
+    except Exception as exc:
+        raise BotLoadError(f"creating bot {spec!r} failed: {type(exc).__name__}: {exc}") from exc

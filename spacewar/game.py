@@ -1,0 +1,265 @@
+"""Game: M Spacewar! matches held in arrays and advanced together by one compiled call.
+
+    game = Game(Rules(), seeds=[1, 2, 3], rounds=5)
+    while not game.over.all():
+        game.step(actions)            # (M, 2) action codes or Action objects
+    game.scores                       # (M, 2)
+
+The force model of a mode is declared with the engine's own force terms (only the terms the
+mode needs) and packed by the engine; the compiled step then calls the engine's integrator
+kernel on each match's bodies.
+"""
+import hashlib
+
+import numpy as np
+
+from engine import Simulation, forces
+from engine._cache import project_cache
+
+from .protocol import Action, Observation, Ship, Torpedo
+from .rules import Rules
+
+with project_cache():
+    from . import core
+
+
+def force_terms(rules):
+    """The engine force terms a mode declares (and so pays for), in order; Thrust is last."""
+    ship_indices = [0, 1]
+    terms = []
+    mu = rules.effective_star_mu
+    softening = 0.5 * rules.star_capture
+    if mu > 0:
+        targets = None if rules.torpedoes_feel_star else ship_indices
+        terms.append(forces.PointMass(mu=mu, pos=(0.0, 0.0), softening=softening, particles=targets))
+    if rules.mode == "newtonian":
+        terms.append(forces.NBodyGravity(G=rules.ship_gravity, softening=rules.hit_box, box=1.0))
+    if rules.mode == "electric":
+        terms.append(forces.Coulomb(k=rules.coulomb_k, softening=rules.hit_box, box=1.0))
+    terms.append(forces.Thrust())
+    return terms
+
+
+def _rules_vector(rules, rounds, thrust_offset):
+    v = np.zeros(core.RN)
+    v[core.R_TURN] = rules.turn_rate
+    v[core.R_ANG_ACCEL] = rules.angular_accel
+    v[core.R_ANG_MOM] = float(rules.angular_momentum)
+    v[core.R_THRUST] = rules.thrust
+    v[core.R_BURN_MIN] = rules.fuel_burn_min
+    v[core.R_BURN_MAX] = rules.fuel_burn_max
+    v[core.R_FUEL] = rules.fuel
+    v[core.R_SHIP_MASS] = rules.ship_mass
+    v[core.R_START] = rules.start_distance
+    v[core.R_NTORP] = rules.torpedoes
+    v[core.R_RELOAD] = rules.reload
+    v[core.R_TLIFE] = rules.torpedo_life
+    v[core.R_MUZZLE] = rules.muzzle_speed
+    v[core.R_OFFSET] = rules.launch_offset
+    v[core.R_TMASS] = rules.torpedo_mass
+    v[core.R_HJUMPS] = rules.hyperspace_jumps
+    v[core.R_HFRAMES] = rules.hyperspace_frames
+    v[core.R_HRECHARGE] = rules.hyperspace_recharge
+    v[core.R_HRISK] = rules.hyperspace_risk
+    v[core.R_REENTRY] = rules.reentry_speed
+    v[core.R_HITBOX] = rules.hit_box
+    v[core.R_DIAMOND] = rules.hit_diamond
+    v[core.R_DELAY] = rules.post_round_delay
+    v[core.R_MAXFRAMES] = rules.max_round_frames
+    v[core.R_ROUNDS] = rounds
+    v[core.R_MAXEXTRA] = rules.max_extra_rounds
+    v[core.R_STAR] = rules.effective_star_mu
+    v[core.R_CAPTURE] = rules.star_capture
+    v[core.R_STAR_KILLS] = float(rules.star_kills)
+    v[core.R_SINGLE] = float(rules.single_shot)
+    v[core.R_TORP_STAR] = float(rules.torpedoes_feel_star)
+    v[core.R_CHARGE] = rules.charge
+    v[core.R_FLIP_CD] = rules.flip_cooldown
+    v[core.R_ELECTRIC] = float(rules.mode == "electric")
+    v[core.R_THRUST_OFF] = thrust_offset
+    return v
+
+
+def seed_state(seed):
+    """A 64-bit stream state from any non-negative int seed (via numpy's SeedSequence)."""
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise ValueError(f"seed must be an int >= 0, got {seed!r}")
+    return np.random.SeedSequence(int(seed)).generate_state(1, np.uint64)[0]
+
+
+class Game:
+    """``len(seeds)`` matches of ``rounds`` rounds each under ``rules``."""
+
+    def __init__(self, rules=None, seeds=(0,), rounds=5):
+        rules = Rules() if rules is None else rules
+        if not isinstance(rules, Rules):
+            raise TypeError(f"rules must be a spacewar.Rules, got {rules!r}")
+        if isinstance(rounds, bool) or not isinstance(rounds, (int, np.integer)) or rounds < 1:
+            raise ValueError(f"rounds must be an int >= 1, got {rounds!r}")
+        seeds = list(seeds)
+        if not seeds:
+            raise ValueError("seeds must hold at least one seed (one per match)")
+        self.rules = rules
+        self.rounds = int(rounds)
+        self.seeds = seeds
+        m = len(seeds)
+        t = rules.torpedoes
+        self.n_bodies = nb = 2 + 2 * t
+        # the engine packs the mode's force terms; a template simulation checks them
+        template = Simulation(dim=2, integrator="symplectic_euler", dt=1.0, capacity=nb)
+        template.add_many(mass=np.full(nb, rules.ship_mass), pos=np.zeros((nb, 2)))
+        self.terms = force_terms(rules)
+        for term in self.terms:
+            template.add_force(term)
+        thrust = self.terms[-1]
+        thrust.set(0, (0.0, 0.0))
+        thrust.set(1, (0.0, 0.0))
+        kinds, fp, foff, ip, ioff = template._current_model()
+        self._static_model = (kinds, foff, ip, ioff)
+        self.fp = np.repeat(fp[None, :], m, axis=0)
+        self.rp = _rules_vector(rules, self.rounds, int(foff[len(self.terms) - 1]))
+        self.drifts, self.kicks = core.drift_kick()
+        # state
+        self.pos = np.zeros((m, 2, nb))
+        self.vel = np.zeros((m, 2, nb))
+        self.mass = np.full((m, nb), rules.torpedo_mass)
+        self.charge = np.zeros((m, nb))
+        self.radius = np.zeros((m, nb))
+        self.active = np.zeros((m, nb), dtype=np.bool_)
+        self.test = np.zeros((m, nb), dtype=np.bool_)
+        self.test[:, 2:] = True  # torpedoes feel gravity but exert none
+        self.ship_f = np.zeros((m, 2, core.SF))
+        self.ship_i = np.zeros((m, 2, core.SI), dtype=np.int64)
+        self.torp_life = np.zeros((m, 2 * t), dtype=np.int64)
+        self.mi = np.zeros((m, core.MI), dtype=np.int64)
+        self.rng = np.array([seed_state(s) for s in seeds], dtype=np.uint64)
+        self._actions = np.full((m, 2), core.NOOP, dtype=np.int64)
+        core.reset_all(self.pos, self.vel, self.mass, self.charge, self.active, self.ship_f,
+                       self.ship_i, self.torp_life, self.mi, self.rp)
+
+    # -- stepping -------------------------------------------------------------------
+    @property
+    def n_matches(self):
+        return self.pos.shape[0]
+
+    def step(self, actions=None):
+        """One frame of every match. ``actions``: (M, 2) codes, Action objects, or None (no-ops)."""
+        if actions is None:
+            self._actions[:] = core.NOOP
+        else:
+            self._actions[:] = self._encode(actions)
+        kinds, foff, ip, ioff = self._static_model
+        core.step_all(self._actions, self.pos, self.vel, self.mass, self.charge, self.radius,
+                      self.active, self.test, self.ship_f, self.ship_i, self.torp_life, self.mi,
+                      self.rng, self.fp, kinds, foff, ip, ioff, self.rp, self.drifts, self.kicks)
+
+    def _encode(self, actions):
+        if isinstance(actions, np.ndarray) and actions.dtype.kind in "iu":
+            codes = actions
+        else:
+            codes = np.array([[a.code() if isinstance(a, Action) else a for a in row]
+                              for row in actions], dtype=np.int64)
+        if codes.shape != (self.n_matches, 2):
+            raise ValueError(f"actions must have shape ({self.n_matches}, 2), got {codes.shape}")
+        if codes.min() < 0 or codes.max() >= core.N_ACTIONS:
+            raise ValueError(f"action codes must be in [0, {core.N_ACTIONS}), got {codes.min()}..{codes.max()}")
+        return codes
+
+    # -- read-out -------------------------------------------------------------------
+    @property
+    def over(self):
+        return self.mi[:, core.OVER].astype(bool)
+
+    @property
+    def scores(self):
+        return self.mi[:, [core.SCORE0, core.SCORE1]].copy()
+
+    @property
+    def frame(self):
+        return self.mi[:, core.FRAME].copy()
+
+    def rounds_played(self, m=0):
+        return int(self.mi[m, core.ROUNDS_PLAYED])
+
+    def errored(self, m=0):
+        return bool(self.mi[m, core.ERROR])
+
+    def _ship(self, m, s):
+        f = self.ship_f[m, s]
+        i = self.ship_i[m, s]
+        return Ship(pos=self.pos[m, :, s].copy(), vel=self.vel[m, :, s].copy(),
+                    heading=float(f[core.HEADING]), angular_velocity=float(f[core.OMEGA]),
+                    fuel=float(f[core.FUEL]), torpedoes=int(i[core.TORPS]),
+                    hyperspace=int(i[core.HYPER_LEFT]), alive=bool(i[core.ALIVE]),
+                    in_hyperspace=bool(i[core.IN_HYPER]), reload=int(i[core.RELOAD]),
+                    hyperspace_recharge=int(i[core.HYPER_RECHARGE]),
+                    charge=float(self.charge[m, s]))
+
+    def observe(self, m, seat):
+        """The observation of match ``m`` from seat ``seat``'s side."""
+        rules = self.rules
+        t = rules.torpedoes
+        me, enemy = self._ship(m, seat), self._ship(m, 1 - seat)
+        torpedoes = []
+        vec_t = np.zeros((2 * t, 7))
+        for row, owner in enumerate((seat, 1 - seat)):
+            for k in range(t):
+                b = 2 + owner * t + k
+                if not self.active[m, b]:
+                    continue
+                ttl = int(self.torp_life[m, owner * t + k])
+                p = self.pos[m, :, b].copy()
+                v = self.vel[m, :, b].copy()
+                torpedoes.append(Torpedo(pos=p, vel=v, mine=owner == seat, ttl=ttl,
+                                         charge=float(self.charge[m, b])))
+                vec_t[row * t + k] = (1.0, p[0], p[1], v[0], v[1], float(owner == seat),
+                                      ttl / max(rules.torpedo_life, 1))
+        mi = self.mi[m]
+        score = (int(mi[core.SCORE0 + seat]), int(mi[core.SCORE0 + 1 - seat]))
+        vector = np.concatenate((self._ship_vector(me), self._ship_vector(enemy),
+                                 [rules.effective_star_mu / max(rules.star_mu, 1e-300),
+                                  mi[core.ROUND_FRAME] / rules.max_round_frames],
+                                 vec_t.ravel()))
+        return Observation(me=me, enemy=enemy, torpedoes=tuple(torpedoes),
+                           star_pos=np.zeros(2), star_mu=rules.effective_star_mu,
+                           star_capture=rules.star_capture, frame=int(mi[core.FRAME]),
+                           round_frame=int(mi[core.ROUND_FRAME]),
+                           round=int(mi[core.ROUNDS_PLAYED]), score=score, seat=seat,
+                           rules=rules, _vector=vector)
+
+    def _ship_vector(self, ship):
+        r = self.rules
+        return [ship.pos[0], ship.pos[1], ship.vel[0], ship.vel[1], np.cos(ship.heading),
+                np.sin(ship.heading), ship.angular_velocity, ship.fuel / max(r.fuel, 1e-300),
+                ship.torpedoes / r.torpedoes, ship.hyperspace / max(r.hyperspace_jumps, 1),
+                float(ship.alive), float(ship.in_hyperspace), ship.reload / max(r.reload, 1),
+                float(np.sign(ship.charge))]
+
+    def snapshot(self, m=0):
+        """Plain data for drawing match ``m``: ships, torpedoes, score, frame."""
+        t = self.rules.torpedoes
+        ships = []
+        for s in range(2):
+            i = self.ship_i[m, s]
+            ships.append({"pos": self.pos[m, :, s].tolist(), "heading": float(self.ship_f[m, s, core.HEADING]),
+                          "alive": bool(i[core.ALIVE]), "in_hyperspace": bool(i[core.IN_HYPER]),
+                          "thrusting": bool(i[core.THRUSTING]), "killed_at": int(i[core.KILLED_AT]),
+                          "fuel": float(self.ship_f[m, s, core.FUEL]), "torpedoes": int(i[core.TORPS]),
+                          "charge": float(self.charge[m, s])})
+        live = [b for b in range(2, 2 + 2 * t) if self.active[m, b]]
+        return {"frame": int(self.mi[m, core.FRAME]), "round_frame": int(self.mi[m, core.ROUND_FRAME]),
+                "round": int(self.mi[m, core.ROUNDS_PLAYED]), "scores": self.scores[m].tolist(),
+                "ships": ships,
+                "torpedoes": [{"pos": self.pos[m, :, b].tolist(), "owner": (b - 2) // t} for b in live],
+                "star": self.rules.effective_star_mu > 0, "over": bool(self.mi[m, core.OVER])}
+
+    def state_hash(self, m=0):
+        """SHA-256 of every array of match ``m``: equal hashes mean bit-identical states."""
+        h = hashlib.sha256()
+        for arr in (self.pos, self.vel, self.mass, self.charge, self.active, self.ship_f,
+                    self.ship_i, self.torp_life, self.mi, self.rng, self.fp):
+            h.update(np.ascontiguousarray(arr[m]).tobytes())
+        return h.hexdigest()
+
+
+__all__ = ["Game", "force_terms", "seed_state"]

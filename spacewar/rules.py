@@ -1,0 +1,139 @@
+"""The rules of Spacewar! (1962), in float units, with the original's ratios kept.
+
+Units: the arena is a torus of side 1 (x and y in [-0.5, 0.5)), one time unit is one frame.
+The PDP-1 screen was 1024 points across, so one point is 1/1024 of the arena. Each frame the
+ships move as in the original: velocity += thrust + gravity, then position += velocity, which
+is the engine's ``symplectic_euler`` with dt = 1 frame.
+
+Frame counts come from the version 3.1 source as summarised in
+``shared/reference/spacewar-1962.md`` (reload 16, torpedo life 96, 32 torpedoes, 8 hyperspace
+jumps of 32 frames with 128 to recharge, break-up risk k/8 on jump k, 192 frames after a
+round, about 100 frames for a full turn, about 1000 frames of fuel, a diamond hit test of 12
+and 18 points). Accelerations and speeds are chosen in the same proportions as the original's
+play: the heavy star out-pulls full thrust only close in, a torpedo crosses a third of the
+arena in its lifetime.
+
+Sense-switch options: ``star`` heavy / light (1/4) / none, ``star_kills`` (else the ship is
+moved to the corner at rest), ``angular_momentum``, ``single_shot``. Modes beyond 1962:
+``newtonian`` (torpedoes feel the star, ships attract each other and the torpedoes, N-body
+through the engine) and ``electric`` (charged ships and torpedoes, Coulomb forces, polarity flip).
+"""
+import dataclasses
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+POINT = 1.0 / 1024.0
+MODES = ("classic", "newtonian", "electric")
+STARS = ("heavy", "light", "none")
+
+
+@dataclass(frozen=True)
+class Rules:
+    """Every number the game uses. Frozen: make variants with ``rules.replace(...)``."""
+
+    mode: str = "classic"
+    # sense switches
+    star: str = "heavy"
+    star_kills: bool = True
+    angular_momentum: bool = False
+    single_shot: bool = False
+    # the star
+    star_mu: float = 2.5e-7  # heavy star's G M in arena^3 / frame^2; light is a quarter
+    star_capture: float = 8 * POINT
+    # ships
+    turn_rate: float = 2.0 * math.pi / 100.0  # rad per frame: a full turn in 100 frames
+    angular_accel: float = 2.0 * math.pi / 1600.0  # rad per frame^2 with angular momentum
+    thrust: float = 2.0e-5  # arena / frame^2
+    fuel: float = 1000.0  # frames of thrust on average
+    fuel_burn_min: float = 0.5  # each thrusting frame burns uniform(min, max) frames of fuel
+    fuel_burn_max: float = 1.5
+    ship_mass: float = 1.0
+    start_distance: float = 0.3  # from the star along the diagonal
+    # torpedoes
+    torpedoes: int = 32
+    reload: int = 16
+    torpedo_life: int = 96
+    muzzle_speed: float = 4.0e-3  # arena / frame, added to the ship's velocity
+    launch_offset: float = 20 * POINT  # ahead of the ship's nose, clear of its hit box
+    torpedo_mass: float = 0.25
+    # hyperspace
+    hyperspace_jumps: int = 8
+    hyperspace_frames: int = 32
+    hyperspace_recharge: int = 128
+    hyperspace_risk: float = 1.0 / 8.0  # break-up chance per jump already made (k/8 on jump k)
+    reentry_speed: float = 2.0e-3  # re-entry speed is uniform in [0, reentry_speed]
+    # collisions: diamond proximity test, as the original
+    hit_box: float = 12 * POINT
+    hit_diamond: float = 18 * POINT
+    # rounds
+    post_round_delay: int = 192
+    max_round_frames: int = 6000
+    max_extra_rounds: int = 5
+    # newtonian mode
+    ship_gravity: float = 2.0e-8  # G for ship-ship and ship-torpedo attraction (ship mass 1)
+    # electric mode
+    coulomb_k: float = 1.0
+    charge: float = 4.0e-4
+    flip_cooldown: int = 64
+
+    def __post_init__(self):
+        if self.mode not in MODES:
+            raise ValueError(f"mode must be one of {', '.join(MODES)}, got {self.mode!r}")
+        if self.star not in STARS:
+            raise ValueError(f"star must be one of {', '.join(STARS)}, got {self.star!r}")
+        for f in dataclasses.fields(self):
+            value = getattr(self, f.name)
+            if f.type in ("float", float):
+                if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+                    raise ValueError(f"{f.name} must be a finite number, got {value!r}")
+                if value < 0:
+                    raise ValueError(f"{f.name} must be >= 0, got {value!r}")
+            elif f.type in ("int", int):
+                if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
+                    raise ValueError(f"{f.name} must be an int >= 0, got {value!r}")
+            elif f.type in ("bool", bool) and not isinstance(value, bool):
+                raise ValueError(f"{f.name} must be True or False, got {value!r}")
+        if not 1 <= self.torpedoes <= 64:
+            raise ValueError(f"torpedoes must be in [1, 64], got {self.torpedoes!r}")
+        if self.fuel_burn_max < self.fuel_burn_min:
+            raise ValueError(f"fuel_burn_max ({self.fuel_burn_max!r}) must be >= fuel_burn_min "
+                             f"({self.fuel_burn_min!r})")
+        if self.ship_mass <= 0 or self.torpedo_mass <= 0:
+            raise ValueError("ship_mass and torpedo_mass must be > 0")
+        if not 0 < self.start_distance < 0.5:
+            raise ValueError(f"start_distance must be in (0, 0.5), got {self.start_distance!r}")
+
+    @property
+    def effective_star_mu(self):
+        """The star's G M with the heavy / light / none switch applied."""
+        return {"heavy": self.star_mu, "light": 0.25 * self.star_mu, "none": 0.0}[self.star]
+
+    @property
+    def torpedoes_feel_star(self):
+        return self.mode == "newtonian"
+
+    def replace(self, **changes):
+        return dataclasses.replace(self, **changes)
+
+    def to_dict(self):
+        return dataclasses.asdict(self)
+
+    @classmethod
+    def from_dict(cls, data):
+        """Rules from a dict (e.g. a replay file); unknown keys are an error."""
+        names = {f.name for f in dataclasses.fields(cls)}
+        unknown = sorted(set(data) - names)
+        if unknown:
+            raise ValueError(f"unknown rules field(s): {', '.join(unknown)}")
+        return cls(**data)
+
+
+OPTIONS_HELP = {
+    "mode": "classic (1962), newtonian (N-body) or electric (Coulomb)",
+    "star": "heavy, light (1/4) or none",
+    "star_kills": "touching the star destroys the ship (else: moved to the corner at rest)",
+    "angular_momentum": "turn keys change the angular velocity (sense switch 1)",
+    "single_shot": "one torpedo per press of fire (sense switch 3)",
+}
