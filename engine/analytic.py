@@ -24,9 +24,10 @@ compiled game loop.
 Compiled cores
 --------------
 ``stumpff(z) -> (c0, c1, c2, c3)``
-``universal_anomaly(r0n, sigma0, alpha, tau) -> chi``
+``universal_anomaly(r0n, sigma0, alpha, tau) -> chi``  (tau = sqrt(mu) t)
 ``lagrange_coefficients(r0, v0, mu, t) -> (f, g, fdot, gdot)``
-``kepler_step(r0, v0, mu, t, r_out, v_out) -> None``  (in place; aliasing ok)
+``kepler_step(r0, v0, mu, t, r_out, v_out) -> None``  (in place; aliasing ok;
+the most accurate route, used by all the others)
 ``kepler_propagate(r0, v0, mu, t) -> (r, v)``
 ``kepler_propagate_times(r0, v0, mu, times) -> (R, V)``  (shape (n, dim))
 ``orbit_invariants(r0, v0, mu) -> (a, e, energy, period, h, p, periapsis)``
@@ -94,19 +95,15 @@ _RESIDUAL_RTOL = 4.0 * 2.220446049250313e-16
 
 
 # ---------------------------------------------------------------------------
-# Compiled cores
-# ---------------------------------------------------------------------------
-
-
-# ---------------------------------------------------------------------------
-# Compensated arithmetic for alpha = 2/r - v^2/mu
+# Compiled cores.  Compensated arithmetic for alpha = 2/r - v^2/mu first.
 # ---------------------------------------------------------------------------
 # Near-parabolic states have 2/r and v^2/mu nearly equal, so plain floating
 # point leaves alpha (= 1/a) with a relative error of eps * (2/r) / |alpha| --
 # 4e-12 at e = 0.99 near periapsis.  That error becomes a period error, and
 # the phase drifts by it every orbit.  Computing alpha in double-double
-# (error-free transformations: Knuth's TwoSum, Dekker's split/TwoProduct,
-# Ogita, Rump & Oishi 2005 "Accurate sum and dot product") makes it correct
+# (error-free transformations: Knuth's TwoSum, Dekker's 1971 split and
+# TwoProduct, summed as in Ogita, Rump & Oishi, "Accurate sum and dot
+# product", SIAM J. Sci. Comput. 26, 2005) makes it correct
 # to a few ulps of alpha itself, so the only loss left is the input's own
 # rounding.  No FMA is needed, which keeps this portable under numba.
 
@@ -307,9 +304,8 @@ def universal_anomaly(r0n, sigma0, alpha, tau):
                 break
             y = y2
             G, r, noise = _kepler_residual(y, r0n, sig, alpha, target)
-            if not (abs(G) >= abs(Gb)):  # smaller, or nan (never chosen)
-                if abs(G) < abs(Gb):
-                    yb, Gb, rb = y, G, r
+            if abs(G) < abs(Gb):
+                yb, Gb, rb = y, G, r
             if G < 0.0:
                 lo = y
             else:  # positive, or nan from overflow far beyond the root
@@ -383,6 +379,10 @@ def lagrange_coefficients(r0, v0, mu, t):
     motion is exactly periodic), so arbitrarily long times keep full
     precision relative to ``t`` itself.
 
+    These coefficients are exact, but far from periapsis on open or
+    near-parabolic orbits they are large and ``f r0 + g v0`` cancels;
+    :func:`kepler_step` avoids that and is what :func:`kepler` uses.
+
     ``r0`` and ``v0`` are float arrays of equal length (2 or 3), ``mu > 0``.
     """
     r0n, v02, rv, alpha = _state_scalars(r0, v0, mu)
@@ -448,6 +448,12 @@ def kepler_step(r0, v0, mu, t, r_out, v_out):
     reaches the focus at ``t_p = 0`` and is continued as a bounce.
     """
     n = r0.shape[0]
+    if t == 0.0:
+        # Exactly the input (the periapsis route below would round it).
+        for i in range(n):
+            r_out[i] = r0[i]
+            v_out[i] = v0[i]
+        return
     r0n, v02, rv, alpha = _state_scalars(r0, v0, mu)
     if n == 3:
         hx = r0[1] * v0[2] - r0[2] * v0[1]
@@ -744,7 +750,11 @@ def ballistic(p0, v0, g, t):
     p = p0a + v0a * tt + 0.5 * ga * (tt * tt)
     v = v0a + ga * tt
     out_shape = ta.shape + shape
-    return np.broadcast_to(p, out_shape).copy(), np.broadcast_to(v, out_shape).copy()
+    p = np.broadcast_to(p, out_shape).copy()
+    v = np.broadcast_to(v, out_shape).copy()
+    if out_shape == ():
+        return float(p), float(v)
+    return p, v
 
 
 def kepler(r0, v0, mu, t):
@@ -766,10 +776,15 @@ def kepler(r0, v0, mu, t):
     coefficients (see :func:`lagrange_coefficients`).  Elliptic, circular,
     parabolic and hyperbolic orbits use the same formulas; elliptic times are
     first reduced modulo the period, so millions of orbits stay accurate.
+    Two refinements keep the error at the level the rounding of the input
+    itself implies: ``alpha`` is computed in compensated (double-double)
+    arithmetic, which matters near e = 1, and a state farther than twice the
+    periapsis distance is propagated from periapsis, which matters for
+    distant hyperbolic and near-parabolic arcs (see :func:`kepler_step`).
 
-    Radial orbits (``r0`` parallel to ``v0``) are supported; a bound radial
-    orbit is continued through the collision as the regularised elastic
-    bounce, and exactly at the collision instant the velocity is infinite.
+    Radial orbits (``r0`` parallel to ``v0``) are supported; they are
+    continued through the collision as the regularised elastic bounce, and
+    exactly at the collision instant the velocity is infinite.
 
     Returns ``(r, v)`` as arrays of shape ``(dim,)``, or ``(len(t), dim)``
     for an array of times.  The compiled core is :func:`kepler_propagate`

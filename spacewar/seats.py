@@ -173,10 +173,13 @@ class ProcessSeat:
 
 def open_seat(spec, seed, budget, isolation="auto"):
     """A seat for bot ``spec``: ``inline``, ``process``, or ``auto`` (built-ins inline)."""
-    from .bots import is_builtin
+    from .bots import BotLoadError, available, is_builtin
 
     if isolation not in ("auto", "inline", "process"):
         raise ValueError(f"isolation must be auto, inline or process, got {isolation!r}")
+    if not isinstance(spec, str) or (":" not in spec and not is_builtin(spec)):
+        raise BotLoadError(f"unknown bot {spec!r}; available: {', '.join(available())} "
+                           "(or give package.module:Class or path/to/file.py:Class)")
     if isolation == "inline" or (isolation == "auto" and is_builtin(spec)):
         return InlineSeat(spec, seed, budget)
     return ProcessSeat(spec, seed, budget)

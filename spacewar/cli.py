@@ -1,0 +1,223 @@
+"""The ``spacewar`` command: bots, match, tournament, replay, play."""
+import argparse
+import json
+import sys
+
+from .rules import MODES, STARS, Rules
+
+
+def _rules_from(args):
+    return Rules(mode=args.mode, star=args.star, star_kills=not args.star_teleports,
+                 angular_momentum=args.angular_momentum, single_shot=args.single_shot)
+
+
+def _add_rules_options(p):
+    g = p.add_argument_group("rules (the 1962 sense switches, and newer modes)")
+    g.add_argument("--mode", choices=MODES, default="classic",
+                   help="classic (1962), newtonian (N-body: ships attract, torpedoes feel the "
+                        "star) or electric (charged ships and torpedoes, F flips polarity)")
+    g.add_argument("--star", choices=STARS, default="heavy", help="heavy, light (1/4) or none")
+    g.add_argument("--star-teleports", action="store_true",
+                   help="touching the star moves the ship to the corner instead of killing it")
+    g.add_argument("--angular-momentum", action="store_true",
+                   help="turn keys change the angular velocity")
+    g.add_argument("--single-shot", action="store_true", help="one torpedo per press of fire")
+
+
+def _add_fault_options(p):
+    g = p.add_argument_group("bot fault isolation")
+    g.add_argument("--budget-ms", type=float, default=50.0,
+                   help="time budget per action in ms; a slower answer is dropped (default 50)")
+    g.add_argument("--max-faults", type=int, default=25,
+                   help="faults (exception, timeout, invalid action) that forfeit a match (default 25)")
+    g.add_argument("--isolation", choices=("auto", "inline", "process"), default="auto",
+                   help="run bots in this process (inline) or each in its own (process); auto: "
+                        "built-in bots inline, others in a process")
+
+
+def _positive_int(text):
+    value = int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be >= 1, got {value}")
+    return value
+
+
+def _seed(text):
+    value = int(text)
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"must be >= 0, got {value}")
+    return value
+
+
+def build_parser():
+    parser = argparse.ArgumentParser(
+        prog="spacewar", description="Spacewar! (1962) on an N-body engine, for bots.")
+    sub = parser.add_subparsers(dest="command", required=True)
+
+    sub.add_parser("bots", help="list the built-in bots")
+
+    m = sub.add_parser("match", help="play one match between two bots")
+    m.add_argument("--p1", required=True, help="bot: a built-in name, package.module:Class or path/to/file.py:Class")
+    m.add_argument("--p2", required=True, help="the other bot")
+    m.add_argument("--seed", type=_seed, default=0)
+    m.add_argument("--rounds", type=_positive_int, default=5)
+    m.add_argument("--json", action="store_true", help="print the result as JSON")
+    m.add_argument("--replay", metavar="FILE", help="record the match to a JSON replay file")
+    _add_rules_options(m)
+    _add_fault_options(m)
+
+    t = sub.add_parser("tournament", help="round robin between bots, both seat orders")
+    t.add_argument("--bots", required=True, help="comma-separated bots")
+    t.add_argument("--games", type=_positive_int, default=10, help="seeds per pair, each played in both seat orders")
+    t.add_argument("--seed", type=_seed, default=1)
+    t.add_argument("--rounds", type=_positive_int, default=3)
+    t.add_argument("--workers", type=_positive_int, default=None, help="worker processes (default: all cores)")
+    t.add_argument("--json", action="store_true", help="print the full report as JSON")
+    t.add_argument("--no-progress", action="store_true", help="no progress bar")
+    _add_rules_options(t)
+    _add_fault_options(t)
+
+    r = sub.add_parser("replay", help="check a replay or render it to a GIF")
+    r.add_argument("file")
+    what = r.add_mutually_exclusive_group(required=True)
+    what.add_argument("--check", action="store_true", help="re-simulate and confirm the identical outcome")
+    what.add_argument("--gif", metavar="OUT", help="render the match to an animated GIF")
+    r.add_argument("--every", type=_positive_int, default=2, help="draw every n-th frame (GIF)")
+    r.add_argument("--size", type=_positive_int, default=480, help="GIF side in pixels")
+
+    p = sub.add_parser("play", help="you at the keyboard against a bot (needs the [viz] extra)")
+    p.add_argument("--p2", default="chaser", help="the bot to play against")
+    p.add_argument("--seed", type=_seed, default=0)
+    p.add_argument("--rounds", type=_positive_int, default=5)
+    p.add_argument("--fps", type=_positive_int, default=60)
+    _add_rules_options(p)
+    return parser
+
+
+def _describe_match(result, timing):
+    p1, p2 = result["bots"]
+    a, b = result["score"]
+    if result["forfeit"]:
+        head = f"{result['winner']} wins: {result['forfeit']} forfeited after repeated faults"
+    elif result["winner"] is None:
+        head = f"draw {a}-{b} between {p1} and {p2}"
+    else:
+        loser = p2 if result["winner_seat"] == 0 else p1
+        head = f"{result['winner']} beats {loser} {max(a, b)}-{min(a, b)}"
+    lines = [head,
+             f"  score {p1} {a} - {b} {p2}, {result['rounds']} rounds, {result['steps']} frames, "
+             f"seed {result['seed']}, mode {result['rules']['mode']}"]
+    for seat, name in enumerate((p1, p2)):
+        f = result["faults"][seat]
+        if f["total"]:
+            kinds = ", ".join(f"{k} {f[k]}" for k in ("raised", "invalid", "timeout", "crashed") if f[k])
+            lines.append(f"  faults of {name} (seat {seat + 1}): {f['total']} ({kinds}); "
+                         f"first: {f['examples'][0]['message']}")
+    if timing is not None:
+        lines.append(f"  {timing['frames_per_second']:.0f} frames/s with bots")
+    return "\n".join(lines)
+
+
+def _cmd_bots(args):
+    from .bots import BUILTIN, BotLoadError, load_bot_class
+
+    for name in sorted(BUILTIN):
+        try:
+            module = sys.modules[load_bot_class(name).__module__]
+            summary = (module.__doc__ or "").strip().splitlines()[0]
+        except (BotLoadError, IndexError) as exc:
+            summary = f"(unavailable: {exc})"
+        print(f"{name:<10}{summary}")
+    print("Other bots: package.module:Class or path/to/file.py:Class")
+    return 0
+
+
+def _cmd_match(args):
+    from .match import play_match
+    from . import replay as replay_io
+
+    result, rep, timing = play_match(
+        args.p1, args.p2, seed=args.seed, rounds=args.rounds, rules=_rules_from(args),
+        budget=args.budget_ms / 1000.0, max_faults=args.max_faults, isolation=args.isolation,
+        record=bool(args.replay))
+    if args.replay:
+        replay_io.save(args.replay, rep)
+    if args.json:
+        print(json.dumps(result, sort_keys=True, indent=2))
+    else:
+        print(_describe_match(result, timing))
+        if args.replay:
+            print(f"  replay written to {args.replay}")
+    return 0
+
+
+def _cmd_tournament(args):
+    from .tournament import format_table, run_tournament
+
+    bots = [b.strip() for b in args.bots.split(",") if b.strip()]
+    report, stats = run_tournament(
+        bots, games=args.games, seed=args.seed, rounds=args.rounds, rules=_rules_from(args),
+        workers=args.workers, progress=not args.no_progress and not args.json,
+        budget=args.budget_ms / 1000.0, max_faults=args.max_faults, isolation=args.isolation)
+    if args.json:
+        print(json.dumps(report, sort_keys=True, indent=2))
+    else:
+        n = len(report["matches"])
+        print(f"Round robin: {len(bots)} bots, {args.games} seeds per pair in both seat orders, "
+              f"{n} matches of {args.rounds} rounds, seed {args.seed}, mode {args.mode}")
+        print(format_table(report))
+        print(f"{stats['frames']} frames played; {stats['frames'] / max(stats['match_seconds'], 1e-9):.0f} "
+              "frames/s per worker with bots")
+    return 0
+
+
+def _cmd_replay(args):
+    from . import replay as replay_io
+
+    data = replay_io.load(args.file)
+    if args.check:
+        ok, details = replay_io.check(data)
+        r = details["replayed"]
+        if ok:
+            print(f"OK: {args.file} replays identically: score {r['score'][0]}-{r['score'][1]}, "
+                  f"{r['rounds']} rounds, {r['steps']} frames, final state {r['final_state_sha256'][:16]}")
+            return 0
+        print(f"MISMATCH: {args.file}: {json.dumps(details['mismatches'], sort_keys=True)}")
+        return 1
+    from .render import render_gif
+
+    render_gif(data, args.gif, every=args.every, size=args.size)
+    print(f"wrote {args.gif}")
+    return 0
+
+
+def _cmd_play(args):
+    from .play import play
+
+    summary = play(p2=args.p2, rules=_rules_from(args), seed=args.seed, rounds=args.rounds,
+                   fps=args.fps)
+    print(summary)
+    return 0
+
+
+COMMANDS = {"bots": _cmd_bots, "match": _cmd_match, "tournament": _cmd_tournament,
+            "replay": _cmd_replay, "play": _cmd_play}
+
+
+def main(argv=None):
+    args = build_parser().parse_args(argv)
+    from .bots import BotLoadError
+    from .replay import ReplayError
+
+    try:
+        return COMMANDS[args.command](args)
+    except (BotLoadError, ReplayError, ValueError) as exc:
+        print(f"spacewar {args.command}: error: {exc}", file=sys.stderr)
+        return 2
+    except ImportError as exc:
+        print(f"spacewar {args.command}: error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

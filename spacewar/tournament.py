@@ -1,0 +1,171 @@
+"""Round-robin tournaments: every pair of bots, both seat orders, games in worker processes.
+
+Each pair plays ``games`` seeds in both seat orders (the same seeds each way, so neither bot
+gets the luckier seat). Match seeds derive from the tournament seed and the match's place in
+the schedule, and results are gathered in schedule order, so the same seed gives the same
+table whatever the number of workers.
+
+Ratings are Elo-scale Bradley-Terry strengths fitted to all results at once (a draw counts
+half a win each way), which unlike sequential Elo updates does not depend on game order:
+P(i beats j) = 1 / (1 + 10^((R_j - R_i) / 400)). Each bot also plays one virtual draw
+against a 1500-rated anchor, so a perfect record gives a finite rating (Hunter 2004, MM
+algorithm; the virtual draw is a standard prior).
+"""
+import concurrent.futures
+import itertools
+import math
+import multiprocessing
+import os
+
+import numpy as np
+
+from .match import DEFAULT_BUDGET, DEFAULT_MAX_FAULTS, play_match
+from .rules import Rules
+
+
+def schedule(bots, games, seed):
+    """The list of (p1, p2, match_seed) in a fixed order."""
+    out = []
+    for pair, (a, b) in enumerate(itertools.combinations(range(len(bots)), 2)):
+        for g in range(games):
+            match_seed = int(np.random.SeedSequence([int(seed), pair, g]).generate_state(1)[0])
+            out.append((bots[a], bots[b], match_seed))
+            out.append((bots[b], bots[a], match_seed))
+    return out
+
+
+def _play(job):
+    p1, p2, match_seed, rounds, rules_dict, budget, max_faults, isolation = job
+    result, _, timing = play_match(p1, p2, seed=match_seed, rounds=rounds,
+                                   rules=Rules.from_dict(rules_dict), budget=budget,
+                                   max_faults=max_faults, isolation=isolation)
+    return result, timing
+
+
+def bradley_terry_elo(names, results, iterations=2000):
+    """Elo-scale ratings from (p1, p2, outcome) with outcome 1, 0.5 or 0 for p1."""
+    k = len(names)
+    index = {n: i for i, n in enumerate(names)}
+    wins = np.zeros((k, k))
+    for p1, p2, outcome in results:
+        i, j = index[p1], index[p2]
+        wins[i, j] += outcome
+        wins[j, i] += 1.0 - outcome
+    games = wins + wins.T
+    strength = np.ones(k)
+    for _ in range(iterations):
+        # MM update with one virtual draw against an anchor of strength 1
+        numer = wins.sum(axis=1) + 0.5
+        denom = (games / (strength[:, None] + strength[None, :])).sum(axis=1) + 1.0 / (strength + 1.0)
+        new = numer / denom
+        if np.allclose(new, strength, rtol=1e-12, atol=0):
+            strength = new
+            break
+        strength = new
+    return {n: 1500.0 + 400.0 * math.log10(strength[index[n]]) for n in names}
+
+
+def run_tournament(bots, games=10, seed=1, rounds=3, rules=None, workers=None, progress=True,
+                   budget=DEFAULT_BUDGET, max_faults=DEFAULT_MAX_FAULTS, isolation="auto"):
+    """Play the round robin; return the table and every match result (plain data)."""
+    bots = list(bots)
+    if len(bots) < 2:
+        raise ValueError(f"a tournament needs at least two bots, got {bots!r}")
+    if len(set(bots)) != len(bots):
+        raise ValueError(f"each bot may enter once, got {bots!r}")
+    if isinstance(games, bool) or not isinstance(games, int) or games < 1:
+        raise ValueError(f"games must be an int >= 1, got {games!r}")
+    from .bots import load_bot_class
+
+    for spec in bots:
+        load_bot_class(spec)  # unknown names fail here, before any work starts
+    rules = Rules() if rules is None else rules
+    workers = (os.cpu_count() or 1) if workers is None else workers
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+        raise ValueError(f"workers must be an int >= 1, got {workers!r}")
+    jobs = [(p1, p2, s, rounds, rules.to_dict(), budget, max_faults, isolation)
+            for p1, p2, s in schedule(bots, games, seed)]
+    bar = _progress(len(jobs), progress)
+    outcomes = []
+    if workers == 1:
+        for job in jobs:
+            outcomes.append(_play(job))
+            bar.update(1)
+    else:
+        ctx = multiprocessing.get_context("spawn")
+        with concurrent.futures.ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
+            futures = [pool.submit(_play, job) for job in jobs]
+            for future in concurrent.futures.as_completed(futures):
+                future.result()  # surface worker errors early
+                bar.update(1)
+            outcomes = [f.result() for f in futures]
+    bar.close()
+    matches = [r for r, _ in outcomes]
+    frames = sum(r["steps"] for r in matches)
+    wall = sum(t["wall_seconds"] for _, t in outcomes)
+    table = _table(bots, matches)
+    return {
+        "bots": bots, "games_per_pairing": games, "seed": int(seed), "rounds": int(rounds),
+        "rules": rules.to_dict(), "table": table,
+        "matches": [{"p1": r["bots"][0], "p2": r["bots"][1], "seed": r["seed"],
+                     "winner": r["winner"], "score": r["score"], "steps": r["steps"],
+                     "forfeit": r["forfeit"],
+                     "faults": [r["faults"][0]["total"], r["faults"][1]["total"]]}
+                    for r in matches],
+    }, {"frames": frames, "match_seconds": wall}
+
+
+def _table(bots, matches):
+    rows = {b: {"bot": b, "played": 0, "wins": 0, "draws": 0, "losses": 0, "points_for": 0,
+                "points_against": 0, "faults": 0, "forfeits": 0} for b in bots}
+    results = []
+    for r in matches:
+        p1, p2 = r["bots"]
+        for seat, me in enumerate((p1, p2)):
+            row = rows[me]
+            row["played"] += 1
+            row["points_for"] += r["score"][seat]
+            row["points_against"] += r["score"][1 - seat]
+            row["faults"] += r["faults"][seat]["total"]
+            row["forfeits"] += int(r["forfeit"] == me)
+            if r["winner_seat"] is None:
+                row["draws"] += 1
+            elif r["winner_seat"] == seat:
+                row["wins"] += 1
+            else:
+                row["losses"] += 1
+        outcome = 0.5 if r["winner_seat"] is None else (1.0 if r["winner_seat"] == 0 else 0.0)
+        results.append((p1, p2, outcome))
+    elo = bradley_terry_elo(bots, results)
+    for b in bots:
+        rows[b]["elo"] = round(elo[b], 1)
+    return sorted(rows.values(), key=lambda row: (-row["elo"], row["bot"]))
+
+
+class _NoBar:
+    def update(self, n):
+        pass
+
+    def close(self):
+        pass
+
+
+def _progress(total, enabled):
+    if not enabled:
+        return _NoBar()
+    try:
+        from tqdm import tqdm
+    except ImportError:
+        return _NoBar()
+    return tqdm(total=total, unit="match", desc="tournament", leave=False)
+
+
+def format_table(report):
+    """The table as fixed-width text."""
+    lines = [f"{'bot':<24}{'played':>7}{'wins':>6}{'draws':>7}{'losses':>8}{'points':>9}"
+             f"{'faults':>8}{'elo':>8}"]
+    for row in report["table"]:
+        lines.append(f"{row['bot']:<24}{row['played']:>7}{row['wins']:>6}{row['draws']:>7}"
+                     f"{row['losses']:>8}{row['points_for']:>5}-{row['points_against']:<3}"
+                     f"{row['faults']:>8}{row['elo']:>8.0f}")
+    return "\n".join(lines)

@@ -1,0 +1,54 @@
+"""Misbehaving and scripted bots for the fault-isolation and rules tests."""
+import time
+
+from spacewar import Action
+
+
+class Raising:
+    def act(self, obs):
+        raise RuntimeError("boom")
+
+
+class Slow:
+    def act(self, obs):
+        time.sleep(0.03)
+        return Action()
+
+
+class Garbage:
+    def act(self, obs):
+        return "left" if obs.frame % 2 else {"turn": 1}
+
+
+class Hanging:
+    def act(self, obs):
+        while True:
+            pass
+
+
+class SometimesRaising:
+    """Raises on 3 frames only, plays a sensible chaser otherwise."""
+
+    def __init__(self):
+        from spacewar.bots.chaser import Chaser
+        self.inner = Chaser()
+
+    def act(self, obs):
+        if obs.frame in (5, 6, 7):
+            raise ValueError("transient")
+        return self.inner.act(obs)
+
+
+class Dies:
+    """Exits its own process on the 3rd frame."""
+
+    def act(self, obs):
+        if obs.frame >= 3:
+            import os
+            os._exit(3)
+        return Action()
+
+
+class Thruster:
+    def act(self, obs):
+        return Action(thrust=True)
