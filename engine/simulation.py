@@ -335,7 +335,7 @@ class Simulation:
         """Potential energy of each declared term, in declaration order."""
         pos, vel, prm, n, model = self._kernel_state()
         out = np.zeros(len(self._forces))
-        potential_terms(self._t, pos, vel, prm, n, model, out)
+        potential_terms(self._t, pos, vel, *prm, n, *model, out)
         return out
 
     def potential_energy(self):

@@ -319,9 +319,8 @@ def step_match(m, actions, pos, vel, mass, charge, radius, active, test, ship_f,
                  ship_i, torp_life, fp, rng, rp)
     # motion: the engine's symplectic Euler kernel, dt = 1 frame, with the engine's forces
     n = pos.shape[2]
-    prm = (mass[m], charge[m], radius[m], active[m], test[m])
-    model = (kinds, fp[m], foff, ip, ioff)
-    _, _, _, bad = splitting.advance(0.0, 1.0, 1, pos[m], vel[m], prm, n, model, False,
+    _, _, _, bad = splitting.advance(0.0, 1.0, 1, pos[m], vel[m], mass[m], charge[m], radius[m],
+                                     active[m], test[m], n, kinds, fp[m], foff, ip, ioff, False,
                                      np.nan, drifts, kicks)
     if bad >= 0:
         mi[m, ERROR] = 1

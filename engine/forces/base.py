@@ -1,10 +1,10 @@
 """What every force term shares: packing its parameters for the compiled dispatcher.
 
 A force term is a Python object holding its parameters plus two numba kernels in its module:
-``accumulate(t, pos, vel, prm, n, fp, ip, acc)`` adds its acceleration into ``acc`` and
-``potential(t, pos, vel, prm, n, fp, ip)`` returns its potential energy (0.0 when the term is not
-conservative). ``fp``/``ip`` are the term's float and integer parameters flattened; ``prm`` is
-``(mass, charge, radius, active, test)``. The simulation concatenates all declared terms into
+``accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc)``
+adds its acceleration into ``acc`` and ``potential(...)`` (the same arguments but ``acc``)
+returns its potential energy (0.0 when the term is not conservative). The term's float
+parameters are ``fp[f0:f1]`` and its integer ones ``ip[i0:i1]``. The simulation concatenates all declared terms into
 one table so that a step calls one compiled function and pays only for the declared terms.
 """
 import numpy as np

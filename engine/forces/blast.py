@@ -20,19 +20,17 @@ KIND = 9
 
 
 @njit(cache=True, error_model="numpy")
-def accumulate(t, pos, vel, prm, n, fp, ip, acc):
-    mass = prm[0]
-    active = prm[3]
-    strength, scale, t0, duration = fp[0], fp[1], fp[2], fp[3]
+def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc):
+    strength, scale, t0, duration = fp[f0], fp[f0 + 1], fp[f0 + 2], fp[f0 + 3]
     if not (t0 <= t < t0 + duration):
         return
     dim = pos.shape[0]
-    cz = fp[6] if dim == 3 else 0.0
+    cz = fp[f0 + 6] if dim == 3 else 0.0
     for i in range(n):
         if not active[i]:
             continue
-        dx = pos[0, i] - fp[4]
-        dy = pos[1, i] - fp[5]
+        dx = pos[0, i] - fp[f0 + 4]
+        dy = pos[1, i] - fp[f0 + 5]
         dz = pos[2, i] - cz if dim == 3 else 0.0
         r = math.sqrt(dx * dx + dy * dy + dz * dz)
         if r == 0.0:
@@ -43,7 +41,7 @@ def accumulate(t, pos, vel, prm, n, fp, ip, acc):
 
 
 @njit(cache=True, error_model="numpy")
-def potential(t, pos, vel, prm, n, fp, ip):
+def potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1):
     return 0.0
 
 

@@ -49,10 +49,9 @@ def _submerged_integral(d, radius, dim):
 
 
 @njit(cache=True, error_model="numpy")
-def accumulate(t, pos, vel, prm, n, fp, ip, acc):
-    mass, _, radius, active, _ = prm
-    level, rho_g = fp[0], fp[1]
-    up = ip[0]
+def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc):
+    level, rho_g = fp[f0], fp[f0 + 1]
+    up = ip[i0]
     dim = pos.shape[0]
     for i in range(n):
         if not active[i] or radius[i] == 0.0:
@@ -68,10 +67,9 @@ def accumulate(t, pos, vel, prm, n, fp, ip, acc):
 
 
 @njit(cache=True, error_model="numpy")
-def potential(t, pos, vel, prm, n, fp, ip):
-    _, _, radius, active, _ = prm
-    level, rho_g = fp[0], fp[1]
-    up = ip[0]
+def potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1):
+    level, rho_g = fp[f0], fp[f0 + 1]
+    up = ip[i0]
     dim = pos.shape[0]
     u = 0.0
     for i in range(n):

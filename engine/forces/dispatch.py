@@ -4,6 +4,10 @@ A simulation's terms are packed into ``model = (kinds, fp, foff, ip, ioff)``: te
 kind ``kinds[s]`` and parameters ``fp[foff[s]:foff[s+1]]`` and ``ip[ioff[s]:ioff[s+1]]``. The
 branch per term per evaluation is negligible against the work of the terms themselves, and
 having one signature means every integrator is compiled once and cached, whatever the scene.
+
+Kernels take plain arrays and offsets, never tuples or slices: in numba each array view made
+or unpacked in a hot loop costs reference-count updates, which for a five-body system cost
+four times the physics itself.
 """
 import numpy as np
 from numba import njit
@@ -12,60 +16,64 @@ from . import (blast, buoyancy, coulomb, drag, gravity, point_mass, springs, thr
                uniform_gravity, wind)
 
 
-@njit(cache=True, error_model="numpy")
-def accelerations(t, pos, vel, prm, n, model, acc):
+@njit(cache=True, error_model="numpy", inline="always")
+def accelerations(t, pos, vel, mass, charge, radius, active, test, n, kinds, fp, foff, ip, ioff,
+                  acc):
     """Overwrite ``acc[:, :n]`` with the total acceleration of every declared term at time t."""
-    kinds, fp_all, foff, ip_all, ioff = model
     for k in range(acc.shape[0]):
         for i in range(n):
             acc[k, i] = 0.0
     for s in range(kinds.shape[0]):
-        fp = fp_all[foff[s]:foff[s + 1]]
-        ip = ip_all[ioff[s]:ioff[s + 1]]
+        f0 = foff[s]
+        f1 = foff[s + 1]
+        i0 = ioff[s]
+        i1 = ioff[s + 1]
         kind = kinds[s]
         if kind == gravity.KIND:
-            gravity.accumulate(t, pos, vel, prm, n, fp, ip, acc)
+            gravity.accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc)
         elif kind == point_mass.KIND:
-            point_mass.accumulate(t, pos, vel, prm, n, fp, ip, acc)
+            point_mass.accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc)
         elif kind == uniform_gravity.KIND:
-            uniform_gravity.accumulate(t, pos, vel, prm, n, fp, ip, acc)
+            uniform_gravity.accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc)
         elif kind == coulomb.KIND:
-            coulomb.accumulate(t, pos, vel, prm, n, fp, ip, acc)
+            coulomb.accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc)
         elif kind == springs.KIND:
-            springs.accumulate(t, pos, vel, prm, n, fp, ip, acc)
+            springs.accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc)
         elif kind == drag.KIND:
-            drag.accumulate(t, pos, vel, prm, n, fp, ip, acc)
+            drag.accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc)
         elif kind == thrust.KIND:
-            thrust.accumulate(t, pos, vel, prm, n, fp, ip, acc)
+            thrust.accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc)
         elif kind == wind.KIND:
-            wind.accumulate(t, pos, vel, prm, n, fp, ip, acc)
+            wind.accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc)
         elif kind == buoyancy.KIND:
-            buoyancy.accumulate(t, pos, vel, prm, n, fp, ip, acc)
+            buoyancy.accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc)
         elif kind == blast.KIND:
-            blast.accumulate(t, pos, vel, prm, n, fp, ip, acc)
+            blast.accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc)
 
 
 @njit(cache=True, error_model="numpy")
-def potential_terms(t, pos, vel, prm, n, model, out):
+def potential_terms(t, pos, vel, mass, charge, radius, active, test, n, kinds, fp, foff, ip,
+                    ioff, out):
     """Write each term's potential energy into ``out[s]`` (0 for non-conservative terms)."""
-    kinds, fp_all, foff, ip_all, ioff = model
     for s in range(kinds.shape[0]):
-        fp = fp_all[foff[s]:foff[s + 1]]
-        ip = ip_all[ioff[s]:ioff[s + 1]]
+        f0 = foff[s]
+        f1 = foff[s + 1]
+        i0 = ioff[s]
+        i1 = ioff[s + 1]
         kind = kinds[s]
         u = 0.0
         if kind == gravity.KIND:
-            u = gravity.potential(t, pos, vel, prm, n, fp, ip)
+            u = gravity.potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1)
         elif kind == point_mass.KIND:
-            u = point_mass.potential(t, pos, vel, prm, n, fp, ip)
+            u = point_mass.potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1)
         elif kind == uniform_gravity.KIND:
-            u = uniform_gravity.potential(t, pos, vel, prm, n, fp, ip)
+            u = uniform_gravity.potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1)
         elif kind == coulomb.KIND:
-            u = coulomb.potential(t, pos, vel, prm, n, fp, ip)
+            u = coulomb.potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1)
         elif kind == springs.KIND:
-            u = springs.potential(t, pos, vel, prm, n, fp, ip)
+            u = springs.potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1)
         elif kind == buoyancy.KIND:
-            u = buoyancy.potential(t, pos, vel, prm, n, fp, ip)
+            u = buoyancy.potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1)
         out[s] = u
 
 

@@ -15,11 +15,9 @@ KIND = 5
 
 
 @njit(cache=True, error_model="numpy")
-def accumulate(t, pos, vel, prm, n, fp, ip, acc):
-    mass = prm[0]
-    active = prm[3]
-    c1 = fp[0]
-    c2 = fp[1]
+def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc):
+    c1 = fp[f0]
+    c2 = fp[f0 + 1]
     dim = pos.shape[0]
     for i in range(n):
         if not active[i]:
@@ -32,7 +30,7 @@ def accumulate(t, pos, vel, prm, n, fp, ip, acc):
 
 
 @njit(cache=True, error_model="numpy")
-def potential(t, pos, vel, prm, n, fp, ip):
+def potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1):
     return 0.0
 
 

@@ -20,11 +20,10 @@ KIND = 0
 
 
 @njit(cache=True, error_model="numpy")
-def accumulate(t, pos, vel, prm, n, fp, ip, acc):
-    mass, _, _, active, test = prm
-    G = fp[0]
-    eps2 = fp[1]
-    box = fp[2]
+def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc):
+    G = fp[f0]
+    eps2 = fp[f0 + 1]
+    box = fp[f0 + 2]
     dim = pos.shape[0]
     for i in range(n):
         if not active[i]:
@@ -50,11 +49,10 @@ def accumulate(t, pos, vel, prm, n, fp, ip, acc):
 
 
 @njit(cache=True, error_model="numpy")
-def potential(t, pos, vel, prm, n, fp, ip):
-    mass, _, _, active, test = prm
-    G = fp[0]
-    eps2 = fp[1]
-    box = fp[2]
+def potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1):
+    G = fp[f0]
+    eps2 = fp[f0 + 1]
+    box = fp[f0 + 2]
     dim = pos.shape[0]
     u = 0.0
     for i in range(n):

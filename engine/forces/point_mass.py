@@ -19,22 +19,21 @@ KIND = 1
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _target(ip, n, k):
+def _target(ip, i0, i1, k):
     """The k-th particle the attractor acts on: every particle, or only those listed in ip."""
-    return k if ip.shape[0] == 0 else ip[k]
+    return k if i1 == i0 else ip[i0 + k]
 
 
 @njit(cache=True, error_model="numpy")
-def accumulate(t, pos, vel, prm, n, fp, ip, acc):
-    active = prm[3]
-    mu = fp[0]
-    eps2 = fp[1]
+def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc):
+    mu = fp[f0]
+    eps2 = fp[f0 + 1]
     dim = pos.shape[0]
-    cx = fp[2]
-    cy = fp[3]
-    cz = fp[4] if dim == 3 else 0.0
-    for k in range(n if ip.shape[0] == 0 else ip.shape[0]):
-        i = _target(ip, n, k)
+    cx = fp[f0 + 2]
+    cy = fp[f0 + 3]
+    cz = fp[f0 + 4] if dim == 3 else 0.0
+    for k in range(n if i1 == i0 else i1 - i0):
+        i = _target(ip, i0, i1, k)
         if i >= n or not active[i]:
             continue
         dx = pos[0, i] - cx
@@ -49,20 +48,18 @@ def accumulate(t, pos, vel, prm, n, fp, ip, acc):
 
 
 @njit(cache=True, error_model="numpy")
-def potential(t, pos, vel, prm, n, fp, ip):
-    mass = prm[0]
-    active = prm[3]
-    mu = fp[0]
-    eps2 = fp[1]
+def potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1):
+    mu = fp[f0]
+    eps2 = fp[f0 + 1]
     dim = pos.shape[0]
     u = 0.0
-    for j in range(n if ip.shape[0] == 0 else ip.shape[0]):
-        i = _target(ip, n, j)
+    for j in range(n if i1 == i0 else i1 - i0):
+        i = _target(ip, i0, i1, j)
         if i >= n or not active[i]:
             continue
         r2 = eps2
         for k in range(dim):
-            d = pos[k, i] - fp[2 + k]
+            d = pos[k, i] - fp[f0 + 2 + k]
             r2 += d * d
         u -= mu * mass[i] / math.sqrt(r2)
     return u

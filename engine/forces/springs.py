@@ -24,18 +24,17 @@ KIND = 4
 
 
 @njit(cache=True, error_model="numpy")
-def accumulate(t, pos, vel, prm, n, fp, ip, acc):
-    mass, _, _, active, _ = prm
+def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc):
     dim = pos.shape[0]
-    m = ip.shape[0] // 2
+    m = (i1 - i0) // 2
     for s in range(m):
-        a = ip[2 * s]
-        b = ip[2 * s + 1]
+        a = ip[i0 + 2 * s]
+        b = ip[i0 + 2 * s + 1]
         if not (active[a] and active[b]):
             continue
-        k = fp[s]
-        rest = fp[m + s]
-        c = fp[2 * m + s]
+        k = fp[f0 + s]
+        rest = fp[f0 + m + s]
+        c = fp[f0 + 2 * m + s]
         dx, dy, dz = delta(pos, a, b, dim)
         r2 = dx * dx + dy * dy + dz * dz
         r = math.sqrt(r2)
@@ -48,19 +47,18 @@ def accumulate(t, pos, vel, prm, n, fp, ip, acc):
 
 
 @njit(cache=True, error_model="numpy")
-def potential(t, pos, vel, prm, n, fp, ip):
-    active = prm[3]
+def potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1):
     dim = pos.shape[0]
-    m = ip.shape[0] // 2
+    m = (i1 - i0) // 2
     u = 0.0
     for s in range(m):
-        a = ip[2 * s]
-        b = ip[2 * s + 1]
+        a = ip[i0 + 2 * s]
+        b = ip[i0 + 2 * s + 1]
         if not (active[a] and active[b]):
             continue
         dx, dy, dz = delta(pos, a, b, dim)
-        stretch = math.sqrt(dx * dx + dy * dy + dz * dz) - fp[m + s]
-        u += 0.5 * fp[s] * stretch * stretch
+        stretch = math.sqrt(dx * dx + dy * dy + dz * dz) - fp[f0 + m + s]
+        u += 0.5 * fp[f0 + s] * stretch * stretch
     return u
 
 

@@ -14,20 +14,18 @@ KIND = 6
 
 
 @njit(cache=True, error_model="numpy")
-def accumulate(t, pos, vel, prm, n, fp, ip, acc):
-    mass = prm[0]
-    active = prm[3]
+def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc):
     dim = pos.shape[0]
-    count = min(n, fp.shape[0] // dim)
+    count = min(n, (f1 - f0) // dim)
     for i in range(count):
         if not active[i]:
             continue
-        f2 = fp[i * dim + 2] if dim == 3 else 0.0
-        add_force(acc, i, dim, fp[i * dim], fp[i * dim + 1], f2, mass[i])
+        f2 = fp[f0 + i * dim + 2] if dim == 3 else 0.0
+        add_force(acc, i, dim, fp[f0 + i * dim], fp[f0 + i * dim + 1], f2, mass[i])
 
 
 @njit(cache=True, error_model="numpy")
-def potential(t, pos, vel, prm, n, fp, ip):
+def potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1):
     return 0.0
 
 

@@ -11,27 +11,24 @@ KIND = 2
 
 
 @njit(cache=True, error_model="numpy")
-def accumulate(t, pos, vel, prm, n, fp, ip, acc):
-    active = prm[3]
+def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc):
     dim = pos.shape[0]
     for i in range(n):
         if not active[i]:
             continue
         for k in range(dim):
-            acc[k, i] += fp[k]
+            acc[k, i] += fp[f0 + k]
 
 
 @njit(cache=True, error_model="numpy")
-def potential(t, pos, vel, prm, n, fp, ip):
-    mass = prm[0]
-    active = prm[3]
+def potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1):
     dim = pos.shape[0]
     u = 0.0
     for i in range(n):
         if not active[i]:
             continue
         for k in range(dim):
-            u -= mass[i] * fp[k] * pos[k, i]
+            u -= mass[i] * fp[f0 + k] * pos[k, i]
     return u
 
 

@@ -20,17 +20,15 @@ KIND = 7
 
 
 @njit(cache=True, error_model="numpy")
-def accumulate(t, pos, vel, prm, n, fp, ip, acc):
-    mass = prm[0]
-    active = prm[3]
-    wx, wy, wz = fp[0], fp[1], fp[2]
+def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc):
+    wx, wy, wz = fp[f0], fp[f0 + 1], fp[f0 + 2]
     wn = math.sqrt(wx * wx + wy * wy + wz * wz)
     if wn == 0.0:
         return
-    for s in range(ip.shape[0] // 3):
-        a = ip[3 * s]
-        b = ip[3 * s + 1]
-        c = ip[3 * s + 2]
+    for s in range((i1 - i0) // 3):
+        a = ip[i0 + 3 * s]
+        b = ip[i0 + 3 * s + 1]
+        c = ip[i0 + 3 * s + 2]
         if not (active[a] and active[b] and active[c]):
             continue
         ux = pos[0, b] - pos[0, a]
@@ -49,7 +47,7 @@ def accumulate(t, pos, vel, prm, n, fp, ip, acc):
 
 
 @njit(cache=True, error_model="numpy")
-def potential(t, pos, vel, prm, n, fp, ip):
+def potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1):
     return 0.0
 
 

@@ -35,12 +35,16 @@ def check_name(name):
 
 
 def advance(name, t, h, steps, pos, vel, prm, n, model, vdep, t_end=np.nan, tol=1e-9):
-    """Advance the state by ``steps`` steps of integrator ``name``; see ``common``."""
+    """Advance the state by ``steps`` steps of integrator ``name``; see ``common``.
+
+    ``prm = (mass, charge, radius, active, test)`` and ``model = (kinds, fp, foff, ip, ioff)``
+    are unpacked here, once per call: the compiled kernels take plain arrays.
+    """
+    args = (t, h, steps, pos, vel, *prm, n, *model, vdep, t_end)
     if name in _COEFFICIENTS:
-        drifts, kicks = _COEFFICIENTS[name]
-        return splitting.advance(t, h, steps, pos, vel, prm, n, model, vdep, t_end, drifts, kicks)
+        return splitting.advance(*args, *_COEFFICIENTS[name])
     if name == "euler":
-        return euler.advance(t, h, steps, pos, vel, prm, n, model, vdep, t_end)
+        return euler.advance(*args)
     if name == "rk4":
-        return runge_kutta.advance(t, h, steps, pos, vel, prm, n, model, vdep, t_end)
-    return dormand_prince.advance(t, h, steps, pos, vel, prm, n, model, vdep, t_end, tol)
+        return runge_kutta.advance(*args)
+    return dormand_prince.advance(*args, tol)

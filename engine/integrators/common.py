@@ -9,6 +9,7 @@ used by adaptive methods (they shorten their last step to land on it; NaN means 
 """
 import math
 
+import numpy as np
 from numba import njit
 
 OK = -1
@@ -39,6 +40,41 @@ def copy_state(src_pos, src_vel, dst_pos, dst_vel, n):
         for i in range(n):
             dst_pos[k, i] = src_pos[k, i]
             dst_vel[k, i] = src_vel[k, i]
+
+
+@njit(cache=True, error_model="numpy")
+def drift_into(dst, pos, vel, mask, n, h):
+    """dst <- p + h v, with v masked to 0 for inactive particles (so they stay exactly put)."""
+    for k in range(pos.shape[0]):
+        for i in range(n):
+            dst[k, i] = pos[k, i] + (h * mask[i]) * vel[k, i]
+
+
+@njit(cache=True, error_model="numpy")
+def kick_into(dst, vel, acc, n, h):
+    """dst <- v + h a (forces are zero on inactive particles, so they keep their velocity)."""
+    for k in range(vel.shape[0]):
+        for i in range(n):
+            dst[k, i] = vel[k, i] + h * acc[k, i]
+
+
+@njit(cache=True, error_model="numpy")
+def active_mask(active, n):
+    mask = np.empty(n)
+    for i in range(n):
+        mask[i] = 1.0 if active[i] else 0.0
+    return mask
+
+
+@njit(cache=True, error_model="numpy")
+def all_finite(pos, vel, n):
+    """True if every position and velocity is finite: x * 0 is 0 for finite x and NaN for
+    inf or NaN, and a sum of zeros never overflows, so one cheap vectorisable pass decides."""
+    s = 0.0
+    for k in range(pos.shape[0]):
+        for i in range(n):
+            s += pos[k, i] * 0.0 + vel[k, i] * 0.0
+    return s == 0.0
 
 
 @njit(cache=True, error_model="numpy")

@@ -75,8 +75,8 @@ def _error(pos, vel, new_pos, new_vel, kx, kv, h, tol, active, n):
 
 
 @njit(cache=True, error_model="numpy")
-def advance(t, h, steps, pos, vel, prm, n, model, vdep, t_end, tol):
-    active = prm[3]
+def advance(t, h, steps, pos, vel, mass, charge, radius, active, test, n, kinds, fp, foff, ip,
+            ioff, vdep, t_end, tol):
     dim = pos.shape[0]
     kx = np.empty((7, dim, n))
     kv = np.empty((7, dim, n))
@@ -84,7 +84,8 @@ def advance(t, h, steps, pos, vel, prm, n, model, vdep, t_end, tol):
     sv = np.empty((dim, n))
     has_end = not math.isnan(t_end)
     kx[0, :, :] = vel[:, :n]
-    accelerations(t, pos, vel, prm, n, model, kv[0])
+    accelerations(t, pos, vel, mass, charge, radius, active, test, n, kinds, fp, foff, ip, ioff,
+                          kv[0])
     done = 0
     rejected = False
     while done < steps:
@@ -100,7 +101,8 @@ def advance(t, h, steps, pos, vel, prm, n, model, vdep, t_end, tol):
         for s in range(1, 7):
             _stage_state(pos, vel, kx, kv, s, h_try, n, sx, sv)
             kx[s, :, :] = sv
-            accelerations(t + _C[s] * h_try, sx, sv, prm, n, model, kv[s])
+            accelerations(t + _C[s] * h_try, sx, sv, mass, charge, radius, active, test, n, kinds, fp, foff, ip, ioff,
+                          kv[s])
         # stage 7 state is the fifth-order solution (sx, sv)
         bad = first_nonfinite(sx, sv, active, n)
         if bad < 0:

@@ -16,8 +16,8 @@ FORCE_EVALUATIONS = 1
 
 
 @njit(cache=True, error_model="numpy")
-def advance(t, h, steps, pos, vel, prm, n, model, vdep, t_end):
-    active = prm[3]
+def advance(t, h, steps, pos, vel, mass, charge, radius, active, test, n, kinds, fp, foff, ip,
+            ioff, vdep, t_end):
     dim = pos.shape[0]
     acc = np.empty((dim, n))
     save_pos = np.empty((dim, n))
@@ -25,7 +25,8 @@ def advance(t, h, steps, pos, vel, prm, n, model, vdep, t_end):
     t0 = t
     for step in range(steps):
         copy_state(pos, vel, save_pos, save_vel, n)
-        accelerations(t, pos, vel, prm, n, model, acc)
+        accelerations(t, pos, vel, mass, charge, radius, active, test, n, kinds, fp, foff, ip, ioff,
+                          acc)
         for k in range(dim):
             for i in range(n):
                 if active[i]:

@@ -26,8 +26,8 @@ def _stage(pos, vel, dx, dv, c, n, out_pos, out_vel):
 
 
 @njit(cache=True, error_model="numpy")
-def advance(t, h, steps, pos, vel, prm, n, model, vdep, t_end):
-    active = prm[3]
+def advance(t, h, steps, pos, vel, mass, charge, radius, active, test, n, kinds, fp, foff, ip,
+            ioff, vdep, t_end):
     dim = pos.shape[0]
     a1 = np.empty((dim, n))
     a2 = np.empty((dim, n))
@@ -41,13 +41,17 @@ def advance(t, h, steps, pos, vel, prm, n, model, vdep, t_end):
     v4 = np.empty((dim, n))
     t0 = t
     for step in range(steps):
-        accelerations(t, pos, vel, prm, n, model, a1)
+        accelerations(t, pos, vel, mass, charge, radius, active, test, n, kinds, fp, foff, ip, ioff,
+                          a1)
         _stage(pos, vel, vel, a1, 0.5 * h, n, x2, v2)
-        accelerations(t + 0.5 * h, x2, v2, prm, n, model, a2)
+        accelerations(t + 0.5 * h, x2, v2, mass, charge, radius, active, test, n, kinds, fp, foff, ip, ioff,
+                          a2)
         _stage(pos, vel, v2, a2, 0.5 * h, n, x3, v3)
-        accelerations(t + 0.5 * h, x3, v3, prm, n, model, a3)
+        accelerations(t + 0.5 * h, x3, v3, mass, charge, radius, active, test, n, kinds, fp, foff, ip, ioff,
+                          a3)
         _stage(pos, vel, v3, a3, h, n, x4, v4)
-        accelerations(t + h, x4, v4, prm, n, model, a4)
+        accelerations(t + h, x4, v4, mass, charge, radius, active, test, n, kinds, fp, foff, ip, ioff,
+                          a4)
         # write the update into x2/v2 first so a blow-up leaves pos/vel untouched
         for k in range(dim):
             for i in range(n):

@@ -20,7 +20,7 @@ import numpy as np
 from numba import njit
 
 from ..forces.dispatch import accelerations
-from .common import OK, copy_state, drift, first_nonfinite, kick
+from .common import OK, active_mask, all_finite, drift_into, first_nonfinite, kick_into
 
 _W1 = 1.0 / (2.0 - 2.0 ** (1.0 / 3.0))
 _W0 = 1.0 - 2.0 * _W1
@@ -61,32 +61,57 @@ def force_evaluations(name):
 
 
 @njit(cache=True, error_model="numpy")
-def advance(t, h, steps, pos, vel, prm, n, model, vdep, t_end, drifts, kicks):
-    active = prm[3]
+def advance(t, h, steps, pos, vel, mass, charge, radius, active, test, n, kinds, fp, foff, ip,
+            ioff, vdep, t_end, drifts, kicks):
     dim = pos.shape[0]
     acc = np.empty((dim, n))
-    save_pos = np.empty((dim, n))
-    save_vel = np.empty((dim, n))
+    mask = active_mask(active, n)
+    # Double buffering: a step reads the state from one buffer and writes the other, so a
+    # step that blows up leaves the last finite state untouched without copying it each step.
+    spare_pos = np.empty((dim, n))
+    spare_vel = np.empty((dim, n))
+    src_pos, src_vel, dst_pos, dst_vel = pos, vel, spare_pos, spare_vel
+    in_spare = False  # does the current state live in the spare buffers?
     fresh = False  # does acc hold the forces of the current state?
     t0 = t
+    done = steps
+    bad = OK
     for step in range(steps):
-        copy_state(pos, vel, save_pos, save_vel, n)
+        x, v = src_pos, src_vel
+        moved_x = False
+        moved_v = False
         t_pos = t
         for s in range(drifts.shape[0]):
             if drifts[s] != 0.0:
-                drift(pos, vel, active, n, drifts[s] * h)
+                drift_into(dst_pos, x, v, mask, n, drifts[s] * h)
+                x = dst_pos
+                moved_x = True
                 t_pos += drifts[s] * h
                 fresh = False
             if kicks[s] != 0.0:
                 if not fresh:
-                    accelerations(t_pos, pos, vel, prm, n, model, acc)
+                    accelerations(t_pos, x, v, mass, charge, radius, active, test, n, kinds, fp, foff, ip, ioff,
+                          acc)
                     fresh = True
-                kick(vel, acc, active, n, kicks[s] * h)
+                kick_into(dst_vel, v, acc, n, kicks[s] * h)
+                v = dst_vel
+                moved_v = True
                 if vdep:
                     fresh = False
-        bad = first_nonfinite(pos, vel, active, n)
-        if bad >= 0:
-            copy_state(save_pos, save_vel, pos, vel, n)
-            return t, h, step, bad
+        if not moved_x:
+            dst_pos[:, :n] = x[:, :n]
+        if not moved_v:
+            dst_vel[:, :n] = v[:, :n]
+        if not all_finite(dst_pos, dst_vel, n):
+            bad = first_nonfinite(dst_pos, dst_vel, active, n)
+            if bad >= 0:
+                done = step
+                break
+        src_pos, dst_pos = dst_pos, src_pos
+        src_vel, dst_vel = dst_vel, src_vel
+        in_spare = not in_spare
         t = t0 + (step + 1) * h
-    return t, h, steps, OK
+    if in_spare:
+        pos[:, :n] = src_pos[:, :n]
+        vel[:, :n] = src_vel[:, :n]
+    return t, h, done, bad

@@ -12,7 +12,7 @@ def accel(sim):
     from engine.forces.dispatch import accelerations
     pos, vel, prm, n, model = sim._kernel_state()
     acc = np.zeros((sim.dim, n))
-    accelerations(sim.t, pos, vel, prm, n, model, acc)
+    accelerations(sim.t, pos, vel, *prm, n, *model, acc)
     return acc.T
 
 
