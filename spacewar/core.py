@@ -309,7 +309,7 @@ def _round_logic(m, pos, vel, mass, charge, active, ship_f, ship_i, torp_life, m
 
 @njit(cache=True)
 def step_match(m, actions, pos, vel, mass, charge, radius, active, test, ship_f, ship_i,
-               torp_life, mi, rng, fp, kinds, foff, ip, ioff, rp, drifts, kicks):
+               torp_life, mi, rng, fp, kinds, foff, ip, ioff, rp, drifts, kicks, work, iwork):
     """Advance match ``m`` by one frame with ``actions[m, 0]`` and ``actions[m, 1]``."""
     if mi[m, OVER] == 1:
         return
@@ -320,8 +320,8 @@ def step_match(m, actions, pos, vel, mass, charge, radius, active, test, ship_f,
     # motion: the engine's symplectic Euler kernel, dt = 1 frame, with the engine's forces
     n = pos.shape[2]
     _, _, _, bad = splitting.advance(0.0, 1.0, 1, pos[m], vel[m], mass[m], charge[m], radius[m],
-                                     active[m], test[m], n, kinds, fp[m], foff, ip, ioff, False,
-                                     np.nan, drifts, kicks)
+                                     active[m], test[m], n, kinds, fp[m], foff, ip, ioff, work,
+                                     iwork, False, np.nan, drifts, kicks)
     if bad >= 0:
         mi[m, ERROR] = 1
         mi[m, OVER] = 1
@@ -344,9 +344,12 @@ def step_match(m, actions, pos, vel, mass, charge, radius, active, test, ship_f,
 def step_all(actions, pos, vel, mass, charge, radius, active, test, ship_f, ship_i, torp_life,
              mi, rng, fp, kinds, foff, ip, ioff, rp, drifts, kicks):
     """Advance every match by one frame (matches already over are left as they are)."""
+    # a match has far fewer bodies than the engine's large-N kernels start at: no workspace
+    work = np.empty(0)
+    iwork = np.empty(0, dtype=np.int64)
     for m in range(pos.shape[0]):
         step_match(m, actions, pos, vel, mass, charge, radius, active, test, ship_f, ship_i,
-                   torp_life, mi, rng, fp, kinds, foff, ip, ioff, rp, drifts, kicks)
+                   torp_life, mi, rng, fp, kinds, foff, ip, ioff, rp, drifts, kicks, work, iwork)
 
 
 @njit(cache=True)

@@ -19,8 +19,9 @@ from .._validate import finite_float, positive_float, vector
 KIND = 9
 
 
-@njit(cache=True, error_model="numpy")
-def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc):
+@njit(cache=True, error_model="numpy", _nrt=False)
+def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc,
+               work, iwork):
     strength, scale, t0, duration = fp[f0], fp[f0 + 1], fp[f0 + 2], fp[f0 + 3]
     if not (t0 <= t < t0 + duration):
         return
@@ -40,7 +41,7 @@ def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, i
         add_force(acc, i, dim, s * dx, s * dy, s * dz, mass[i])
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1):
     return 0.0
 

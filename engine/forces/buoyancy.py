@@ -48,8 +48,9 @@ def _submerged_integral(d, radius, dim):
              + w ** 1.5 / 3.0)
 
 
-@njit(cache=True, error_model="numpy")
-def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc):
+@njit(cache=True, error_model="numpy", _nrt=False)
+def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc,
+               work, iwork):
     level, rho_g = fp[f0], fp[f0 + 1]
     up = ip[i0]
     dim = pos.shape[0]
@@ -66,7 +67,7 @@ def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, i
         add_force(acc, i, dim, f0, f1, f2, mass[i])
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1):
     level, rho_g = fp[f0], fp[f0 + 1]
     up = ip[i0]

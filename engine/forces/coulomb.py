@@ -11,6 +11,7 @@ import math
 
 from numba import njit
 
+from . import pairwise
 from ._kernels import add_force, delta_periodic
 from .base import Force, floats, EMPTY_INTS
 from .._validate import nonnegative_float, finite_float, positive_float
@@ -18,12 +19,16 @@ from .._validate import nonnegative_float, finite_float, positive_float
 KIND = 3
 
 
-@njit(cache=True, error_model="numpy")
-def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc):
+@njit(cache=True, error_model="numpy", _nrt=False)
+def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc,
+               work, iwork):
     k = fp[f0]
     eps2 = fp[f0 + 1]
     box = fp[f0 + 2]
     dim = pos.shape[0]
+    if n >= pairwise.PARALLEL_MIN:
+        pairwise.coulomb(pos, mass, charge, active, n, k, eps2, box, acc, work, iwork)
+        return
     for i in range(n):
         if not active[i] or charge[i] == 0.0:
             continue
@@ -38,7 +43,7 @@ def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, i
             add_force(acc, j, dim, s * dx, s * dy, s * dz, mass[j])
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1):
     k = fp[f0]
     eps2 = fp[f0 + 1]

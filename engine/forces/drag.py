@@ -14,8 +14,9 @@ from .._validate import nonnegative_float
 KIND = 5
 
 
-@njit(cache=True, error_model="numpy")
-def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc):
+@njit(cache=True, error_model="numpy", _nrt=False)
+def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc,
+               work, iwork):
     c1 = fp[f0]
     c2 = fp[f0 + 1]
     dim = pos.shape[0]
@@ -29,7 +30,7 @@ def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, i
         add_force(acc, i, dim, s * vx, s * vy, s * vz, mass[i])
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1):
     return 0.0
 

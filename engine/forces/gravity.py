@@ -6,49 +6,69 @@ space", with Plummer's softening length eps; Aarseth, Gravitational N-Body Simul
 U = - sum_{i<j} G m_i m_j / sqrt(|p_j - p_i|^2 + eps^2)
 
 Each pair is visited once and both bodies get equal and opposite forces, so total momentum is
-conserved to round-off. Test particles feel the field but are not sources.
+conserved to round-off. Test particles feel the field but are not sources (so a pair of test
+particles costs nothing: O(N_massive x N) for test particles around a few bodies). From
+``pairwise.PARALLEL_MIN`` particles on, the vectorised multi-core kernel of ``pairwise`` runs.
 """
 import math
 
 from numba import njit
 
-from ._kernels import delta_periodic
+from . import pairwise
+from ._kernels import delta_periodic, nearest_image
 from .base import Force, floats, EMPTY_INTS
 from .._validate import nonnegative_float, positive_float
 
 KIND = 0
 
 
-@njit(cache=True, error_model="numpy")
-def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc):
+@njit(cache=True, error_model="numpy", _nrt=False)
+def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc,
+               work, iwork):
     G = fp[f0]
     eps2 = fp[f0 + 1]
     box = fp[f0 + 2]
-    dim = pos.shape[0]
+    if n >= pairwise.PARALLEL_MIN:
+        pairwise.gravity(pos, mass, active, test, n, G, eps2, box, acc, work, iwork)
+        return
+    three = pos.shape[0] == 3
     for i in range(n):
         if not active[i]:
             continue
-        gi = 0.0 if test[i] else G * mass[i]
+        ti = test[i]
+        gi = 0.0 if ti else G * mass[i]
+        xi = pos[0, i]
+        yi = pos[1, i]
+        zi = pos[2, i] if three else 0.0
+        axi = 0.0
+        ayi = 0.0
+        azi = 0.0
         for j in range(i + 1, n):
-            if not active[j] or (test[i] and test[j]):
+            if not active[j] or (ti and test[j]):
                 continue
             gj = 0.0 if test[j] else G * mass[j]
-            dx, dy, dz = delta_periodic(pos, i, j, dim, box)
+            dx = nearest_image(pos[0, j] - xi, box)
+            dy = nearest_image(pos[1, j] - yi, box)
+            dz = nearest_image(pos[2, j] - zi, box) if three else 0.0
             r2 = dx * dx + dy * dy + dz * dz + eps2
             inv_r3 = 1.0 / (r2 * math.sqrt(r2))
             # Coincident bodies without softening give 0 * inf = nan: the step then fails loudly.
             si = gj * inv_r3
             sj = gi * inv_r3
-            acc[0, i] += si * dx
-            acc[1, i] += si * dy
+            axi += si * dx
+            ayi += si * dy
             acc[0, j] -= sj * dx
             acc[1, j] -= sj * dy
-            if dim == 3:
-                acc[2, i] += si * dz
+            if three:
+                azi += si * dz
                 acc[2, j] -= sj * dz
+        acc[0, i] += axi
+        acc[1, i] += ayi
+        if three:
+            acc[2, i] += azi
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1):
     G = fp[f0]
     eps2 = fp[f0 + 1]

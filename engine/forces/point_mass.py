@@ -24,8 +24,9 @@ def _target(ip, i0, i1, k):
     return k if i1 == i0 else ip[i0 + k]
 
 
-@njit(cache=True, error_model="numpy")
-def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc):
+@njit(cache=True, error_model="numpy", _nrt=False)
+def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc,
+               work, iwork):
     mu = fp[f0]
     eps2 = fp[f0 + 1]
     dim = pos.shape[0]
@@ -47,7 +48,7 @@ def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, i
             acc[2, i] -= s * dz
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1):
     mu = fp[f0]
     eps2 = fp[f0 + 1]

@@ -23,8 +23,9 @@ from .._validate import per_item, vector, positive_float, nonnegative_float
 KIND = 4
 
 
-@njit(cache=True, error_model="numpy")
-def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc):
+@njit(cache=True, error_model="numpy", _nrt=False)
+def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc,
+               work, iwork):
     dim = pos.shape[0]
     m = (i1 - i0) // 2
     for s in range(m):
@@ -46,7 +47,7 @@ def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, i
         add_force(acc, b, dim, -scale * dx, -scale * dy, -scale * dz, mass[b])
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1):
     dim = pos.shape[0]
     m = (i1 - i0) // 2

@@ -13,8 +13,9 @@ from .._validate import vector
 KIND = 6
 
 
-@njit(cache=True, error_model="numpy")
-def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc):
+@njit(cache=True, error_model="numpy", _nrt=False)
+def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc,
+               work, iwork):
     dim = pos.shape[0]
     count = min(n, (f1 - f0) // dim)
     for i in range(count):
@@ -24,7 +25,7 @@ def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, i
         add_force(acc, i, dim, fp[f0 + i * dim], fp[f0 + i * dim + 1], f2, mass[i])
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1):
     return 0.0
 

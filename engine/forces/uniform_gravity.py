@@ -10,8 +10,9 @@ from .._validate import vector
 KIND = 2
 
 
-@njit(cache=True, error_model="numpy")
-def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc):
+@njit(cache=True, error_model="numpy", _nrt=False)
+def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc,
+               work, iwork):
     dim = pos.shape[0]
     for i in range(n):
         if not active[i]:
@@ -20,7 +21,7 @@ def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, i
             acc[k, i] += fp[f0 + k]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1):
     dim = pos.shape[0]
     u = 0.0

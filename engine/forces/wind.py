@@ -19,8 +19,9 @@ from .._validate import vector
 KIND = 7
 
 
-@njit(cache=True, error_model="numpy")
-def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc):
+@njit(cache=True, error_model="numpy", _nrt=False)
+def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc,
+               work, iwork):
     wx, wy, wz = fp[f0], fp[f0 + 1], fp[f0 + 2]
     wn = math.sqrt(wx * wx + wy * wy + wz * wz)
     if wn == 0.0:
@@ -46,7 +47,7 @@ def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, i
             add_force(acc, v, 3, f * wx, f * wy, f * wz, mass[v])
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1):
     return 0.0
 

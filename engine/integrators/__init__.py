@@ -5,6 +5,7 @@ in compiled code and returns ``(t, h_next, done, bad)`` (see ``common``).
 """
 import numpy as np
 
+from ..forces.pairwise import workspace
 from . import dormand_prince, euler, runge_kutta, splitting
 
 #: every integrator name, in the order of the documentation
@@ -40,7 +41,7 @@ def advance(name, t, h, steps, pos, vel, prm, n, model, vdep, t_end=np.nan, tol=
     ``prm = (mass, charge, radius, active, test)`` and ``model = (kinds, fp, foff, ip, ioff)``
     are unpacked here, once per call: the compiled kernels take plain arrays.
     """
-    args = (t, h, steps, pos, vel, *prm, n, *model, vdep, t_end)
+    args = (t, h, steps, pos, vel, *prm, n, *model, *workspace(n), vdep, t_end)
     if name in _COEFFICIENTS:
         return splitting.advance(*args, *_COEFFICIENTS[name])
     if name == "euler":

@@ -16,46 +16,28 @@ OK = -1
 STEP_COLLAPSED = -2
 
 
-@njit(cache=True, error_model="numpy")
-def drift(pos, vel, active, n, h):
-    """p <- p + h v for every active particle."""
+@njit(cache=True, error_model="numpy", inline="always")
+def drift(pos, vel, mask, n, h):
+    """p <- p + h v, v masked to 0 for inactive particles (so they stay exactly put)."""
     for k in range(pos.shape[0]):
         for i in range(n):
-            if active[i]:
-                pos[k, i] += h * vel[k, i]
+            pos[k, i] += (h * mask[i]) * vel[k, i]
 
 
-@njit(cache=True, error_model="numpy")
-def kick(vel, acc, active, n, h):
-    """v <- v + h a for every active particle."""
+@njit(cache=True, error_model="numpy", inline="always")
+def kick(vel, acc, n, h):
+    """v <- v + h a (forces are zero on inactive particles, so they keep their velocity)."""
     for k in range(vel.shape[0]):
         for i in range(n):
-            if active[i]:
-                vel[k, i] += h * acc[k, i]
+            vel[k, i] += h * acc[k, i]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def copy_state(src_pos, src_vel, dst_pos, dst_vel, n):
     for k in range(src_pos.shape[0]):
         for i in range(n):
             dst_pos[k, i] = src_pos[k, i]
             dst_vel[k, i] = src_vel[k, i]
-
-
-@njit(cache=True, error_model="numpy")
-def drift_into(dst, pos, vel, mask, n, h):
-    """dst <- p + h v, with v masked to 0 for inactive particles (so they stay exactly put)."""
-    for k in range(pos.shape[0]):
-        for i in range(n):
-            dst[k, i] = pos[k, i] + (h * mask[i]) * vel[k, i]
-
-
-@njit(cache=True, error_model="numpy")
-def kick_into(dst, vel, acc, n, h):
-    """dst <- v + h a (forces are zero on inactive particles, so they keep their velocity)."""
-    for k in range(vel.shape[0]):
-        for i in range(n):
-            dst[k, i] = vel[k, i] + h * acc[k, i]
 
 
 @njit(cache=True, error_model="numpy")
@@ -66,7 +48,7 @@ def active_mask(active, n):
     return mask
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def all_finite(pos, vel, n):
     """True if every position and velocity is finite: x * 0 is 0 for finite x and NaN for
     inf or NaN, and a sum of zeros never overflows, so one cheap vectorisable pass decides."""

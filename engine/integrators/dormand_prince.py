@@ -76,7 +76,7 @@ def _error(pos, vel, new_pos, new_vel, kx, kv, h, tol, active, n):
 
 @njit(cache=True, error_model="numpy")
 def advance(t, h, steps, pos, vel, mass, charge, radius, active, test, n, kinds, fp, foff, ip,
-            ioff, vdep, t_end, tol):
+            ioff, work, iwork, vdep, t_end, tol):
     dim = pos.shape[0]
     kx = np.empty((7, dim, n))
     kv = np.empty((7, dim, n))
@@ -85,7 +85,7 @@ def advance(t, h, steps, pos, vel, mass, charge, radius, active, test, n, kinds,
     has_end = not math.isnan(t_end)
     kx[0, :, :] = vel[:, :n]
     accelerations(t, pos, vel, mass, charge, radius, active, test, n, kinds, fp, foff, ip, ioff,
-                          kv[0])
+                          kv[0], work, iwork)
     done = 0
     rejected = False
     while done < steps:
@@ -102,7 +102,7 @@ def advance(t, h, steps, pos, vel, mass, charge, radius, active, test, n, kinds,
             _stage_state(pos, vel, kx, kv, s, h_try, n, sx, sv)
             kx[s, :, :] = sv
             accelerations(t + _C[s] * h_try, sx, sv, mass, charge, radius, active, test, n, kinds, fp, foff, ip, ioff,
-                          kv[s])
+                          kv[s], work, iwork)
         # stage 7 state is the fifth-order solution (sx, sv)
         bad = first_nonfinite(sx, sv, active, n)
         if bad < 0:

@@ -17,7 +17,7 @@ FORCE_EVALUATIONS = 1
 
 @njit(cache=True, error_model="numpy")
 def advance(t, h, steps, pos, vel, mass, charge, radius, active, test, n, kinds, fp, foff, ip,
-            ioff, vdep, t_end):
+            ioff, work, iwork, vdep, t_end):
     dim = pos.shape[0]
     acc = np.empty((dim, n))
     save_pos = np.empty((dim, n))
@@ -26,7 +26,7 @@ def advance(t, h, steps, pos, vel, mass, charge, radius, active, test, n, kinds,
     for step in range(steps):
         copy_state(pos, vel, save_pos, save_vel, n)
         accelerations(t, pos, vel, mass, charge, radius, active, test, n, kinds, fp, foff, ip, ioff,
-                          acc)
+                          acc, work, iwork)
         for k in range(dim):
             for i in range(n):
                 if active[i]:

@@ -27,7 +27,7 @@ def _stage(pos, vel, dx, dv, c, n, out_pos, out_vel):
 
 @njit(cache=True, error_model="numpy")
 def advance(t, h, steps, pos, vel, mass, charge, radius, active, test, n, kinds, fp, foff, ip,
-            ioff, vdep, t_end):
+            ioff, work, iwork, vdep, t_end):
     dim = pos.shape[0]
     a1 = np.empty((dim, n))
     a2 = np.empty((dim, n))
@@ -42,16 +42,16 @@ def advance(t, h, steps, pos, vel, mass, charge, radius, active, test, n, kinds,
     t0 = t
     for step in range(steps):
         accelerations(t, pos, vel, mass, charge, radius, active, test, n, kinds, fp, foff, ip, ioff,
-                          a1)
+                          a1, work, iwork)
         _stage(pos, vel, vel, a1, 0.5 * h, n, x2, v2)
         accelerations(t + 0.5 * h, x2, v2, mass, charge, radius, active, test, n, kinds, fp, foff, ip, ioff,
-                          a2)
+                          a2, work, iwork)
         _stage(pos, vel, v2, a2, 0.5 * h, n, x3, v3)
         accelerations(t + 0.5 * h, x3, v3, mass, charge, radius, active, test, n, kinds, fp, foff, ip, ioff,
-                          a3)
+                          a3, work, iwork)
         _stage(pos, vel, v3, a3, h, n, x4, v4)
         accelerations(t + h, x4, v4, mass, charge, radius, active, test, n, kinds, fp, foff, ip, ioff,
-                          a4)
+                          a4, work, iwork)
         # write the update into x2/v2 first so a blow-up leaves pos/vel untouched
         for k in range(dim):
             for i in range(n):

@@ -20,7 +20,7 @@ import numpy as np
 from numba import njit
 
 from ..forces.dispatch import accelerations
-from .common import OK, active_mask, all_finite, drift_into, first_nonfinite, kick_into
+from .common import OK, active_mask, all_finite, copy_state, drift, first_nonfinite, kick
 
 _W1 = 1.0 / (2.0 - 2.0 ** (1.0 / 3.0))
 _W0 = 1.0 - 2.0 * _W1
@@ -62,56 +62,37 @@ def force_evaluations(name):
 
 @njit(cache=True, error_model="numpy")
 def advance(t, h, steps, pos, vel, mass, charge, radius, active, test, n, kinds, fp, foff, ip,
-            ioff, vdep, t_end, drifts, kicks):
+            ioff, work, iwork, vdep, t_end, drifts, kicks):
+    # Hot-loop rules for numba: every helper is inlined and no array variable is rebound or
+    # sliced inside the loop, since each of those costs atomic reference-count updates that
+    # would outweigh the physics of a small system many times over.
     dim = pos.shape[0]
     acc = np.empty((dim, n))
     mask = active_mask(active, n)
-    # Double buffering: a step reads the state from one buffer and writes the other, so a
-    # step that blows up leaves the last finite state untouched without copying it each step.
-    spare_pos = np.empty((dim, n))
-    spare_vel = np.empty((dim, n))
-    src_pos, src_vel, dst_pos, dst_vel = pos, vel, spare_pos, spare_vel
-    in_spare = False  # does the current state live in the spare buffers?
+    save_pos = np.empty((dim, n))
+    save_vel = np.empty((dim, n))
     fresh = False  # does acc hold the forces of the current state?
     t0 = t
-    done = steps
-    bad = OK
     for step in range(steps):
-        x, v = src_pos, src_vel
-        moved_x = False
-        moved_v = False
+        copy_state(pos, vel, save_pos, save_vel, n)
         t_pos = t
         for s in range(drifts.shape[0]):
             if drifts[s] != 0.0:
-                drift_into(dst_pos, x, v, mask, n, drifts[s] * h)
-                x = dst_pos
-                moved_x = True
+                drift(pos, vel, mask, n, drifts[s] * h)
                 t_pos += drifts[s] * h
                 fresh = False
             if kicks[s] != 0.0:
                 if not fresh:
-                    accelerations(t_pos, x, v, mass, charge, radius, active, test, n, kinds, fp, foff, ip, ioff,
-                          acc)
+                    accelerations(t_pos, pos, vel, mass, charge, radius, active, test, n, kinds,
+                                  fp, foff, ip, ioff, acc, work, iwork)
                     fresh = True
-                kick_into(dst_vel, v, acc, n, kicks[s] * h)
-                v = dst_vel
-                moved_v = True
+                kick(vel, acc, n, kicks[s] * h)
                 if vdep:
                     fresh = False
-        if not moved_x:
-            dst_pos[:, :n] = x[:, :n]
-        if not moved_v:
-            dst_vel[:, :n] = v[:, :n]
-        if not all_finite(dst_pos, dst_vel, n):
-            bad = first_nonfinite(dst_pos, dst_vel, active, n)
+        if not all_finite(pos, vel, n):
+            bad = first_nonfinite(pos, vel, active, n)
             if bad >= 0:
-                done = step
-                break
-        src_pos, dst_pos = dst_pos, src_pos
-        src_vel, dst_vel = dst_vel, src_vel
-        in_spare = not in_spare
+                copy_state(save_pos, save_vel, pos, vel, n)
+                return t, h, step, bad
         t = t0 + (step + 1) * h
-    if in_spare:
-        pos[:, :n] = src_pos[:, :n]
-        vel[:, :n] = src_vel[:, :n]
-    return t, h, done, bad
+    return t, h, steps, OK
