@@ -11,8 +11,9 @@ def accel(sim):
     """The acceleration the declared terms give now (one tiny Euler step reveals it exactly)."""
     from engine.forces.dispatch import accelerations
     pos, vel, prm, n, model = sim._kernel_state()
+    from engine.forces.pairwise import workspace
     acc = np.zeros((sim.dim, n))
-    accelerations(sim.t, pos, vel, *prm, n, *model, acc)
+    accelerations(sim.t, pos, vel, *prm, n, *model, acc, *workspace(n))
     return acc.T
 
 
