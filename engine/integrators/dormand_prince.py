@@ -40,7 +40,7 @@ _MIN_FACTOR = 0.2
 _MAX_FACTOR = 5.0
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _stage_state(pos, vel, kx, kv, s, h, n, out_pos, out_vel):
     """y + h sum_{j<s} a_sj k_j."""
     for k in range(pos.shape[0]):
@@ -56,7 +56,7 @@ def _stage_state(pos, vel, kx, kv, s, h, n, out_pos, out_vel):
             out_vel[k, i] = v
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _error(pos, vel, new_pos, new_vel, kx, kv, h, tol, active, n):
     err = 0.0
     for k in range(pos.shape[0]):

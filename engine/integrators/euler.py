@@ -8,7 +8,7 @@ import numpy as np
 from numba import njit
 
 from ..forces.dispatch import accelerations
-from .common import OK, copy_state, first_nonfinite
+from .common import OK, all_finite, copy_state, first_nonfinite
 
 NAME = "euler"
 ORDER = 1
@@ -32,9 +32,10 @@ def advance(t, h, steps, pos, vel, mass, charge, radius, active, test, n, kinds,
                 if active[i]:
                     pos[k, i] += h * vel[k, i]
                     vel[k, i] += h * acc[k, i]
-        bad = first_nonfinite(pos, vel, active, n)
-        if bad >= 0:
-            copy_state(save_pos, save_vel, pos, vel, n)
-            return t, h, step, bad
+        if not all_finite(pos, vel, n):
+            bad = first_nonfinite(pos, vel, active, n)
+            if bad >= 0:
+                copy_state(save_pos, save_vel, pos, vel, n)
+                return t, h, step, bad
         t = t0 + (step + 1) * h
     return t, h, steps, OK

@@ -9,14 +9,14 @@ import numpy as np
 from numba import njit
 
 from ..forces.dispatch import accelerations
-from .common import OK, first_nonfinite
+from .common import OK, all_finite, first_nonfinite
 
 NAME = "rk4"
 ORDER = 4
 FORCE_EVALUATIONS = 4
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _stage(pos, vel, dx, dv, c, n, out_pos, out_vel):
     """out = y + c * (dx, dv)."""
     for k in range(pos.shape[0]):
@@ -61,9 +61,10 @@ def advance(t, h, steps, pos, vel, mass, charge, radius, active, test, n, kinds,
                 else:
                     x2[k, i] = pos[k, i]
                     v2[k, i] = vel[k, i]
-        bad = first_nonfinite(x2, v2, active, n)
-        if bad >= 0:
-            return t, h, step, bad
+        if not all_finite(x2, v2, n):
+            bad = first_nonfinite(x2, v2, active, n)
+            if bad >= 0:
+                return t, h, step, bad
         pos[:, :n] = x2
         vel[:, :n] = v2
         t = t0 + (step + 1) * h
