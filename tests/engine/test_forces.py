@@ -307,3 +307,19 @@ def test_periodic_box_uses_the_nearest_image(make):
     a = accel(sim)
     np.testing.assert_allclose(a, [(-1.0, 0.0), (1.0, 0.0)], rtol=1e-14)
     assert sim.potential_energy() == pytest.approx(-1.0)
+
+
+def test_gravity_open_space_fast_path_equals_the_general_loop():
+    rng = np.random.default_rng(11)
+    pos = rng.normal(size=(7, 3))
+    mass = rng.uniform(0.5, 2.0, 7)
+    fast = Simulation(dim=3)
+    fast.add_many(mass=mass, pos=pos)
+    fast.add_force(forces.NBodyGravity(G=1.3, softening=0.01))
+    general = Simulation(dim=3)
+    general.add_many(mass=mass, pos=pos)
+    # a periodic box far larger than the system takes the general branchy loop, same numbers
+    general.add_force(forces.NBodyGravity(G=1.3, softening=0.01, box=1e6))
+    np.testing.assert_allclose(accel(fast), accel(general), rtol=1e-14)
+    general.add(mass=0.0, pos=(5.0, 0.0, 0.0), test=True)  # a test particle: general path too
+    np.testing.assert_allclose(accel(general)[:7], accel(fast), rtol=1e-14)

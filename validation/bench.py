@@ -1,0 +1,456 @@
+"""``python -m validation bench``: the engine's speed, measured side by side with references.
+
+Machines are noisy, so every claim is a ratio measured in one run: each repetition times the
+engine and its reference back to back, the ratio of that repetition is kept, and the median
+of the ratios is reported (with the median times). Sections:
+
+1. direct-sum gravity (leapfrog + NBodyGravity) against REBOUND's leapfrog, N = 256, 1024, 4096,
+   with pair interactions per second and the fraction of a measured machine bound;
+2. the Benchmarks Game n-body workload (Sun and four giant planets, symplectic Euler,
+   dt = 0.01) through ``sim.step(n)``, against a plain hand-written numba loop and REBOUND;
+3. scaling of the time per step with N (direct sum) and with N_test (test particles around
+   four massive bodies), with fitted log-log slopes;
+4. the cost of the force terms declared (1, 2 and 4 terms on the same particles);
+5. start-up: ``import engine`` plus a first step, with a warm and with a cold numba cache;
+6. headless Spacewar: frames per second of one match with built-in bots, and of many
+   matches advanced together.
+"""
+import argparse
+import json
+import math
+import os
+import platform
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+SOLAR_MASS = 4.0 * math.pi ** 2
+DAYS_PER_YEAR = 365.24
+# The Benchmarks Game n-body initial conditions (Sun, Jupiter, Saturn, Uranus, Neptune), in
+# AU, AU/year and solar masses (times 4 pi^2), as published with the benchmark.
+NBODY_BODIES = np.array([
+    [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0],
+    [4.84143144246472090e+00, -1.16032004402742839e+00, -1.03622044471123109e-01,
+     1.66007664274403694e-03, 7.69901118419740425e-03, -6.90460016972063023e-05,
+     9.54791938424326609e-04],
+    [8.34336671824457987e+00, 4.12479856412430479e+00, -4.03523417114321381e-01,
+     -2.76742510726862411e-03, 4.99852801234917238e-03, 2.30417297573763929e-05,
+     2.85885980666130812e-04],
+    [1.28943695621391310e+01, -1.51111514016986312e+01, -2.23307578892655734e-01,
+     2.96460137564761618e-03, 2.37847173959480950e-03, -2.96589568540237556e-05,
+     4.36624404335156298e-05],
+    [1.53796971148509165e+01, -2.59193146099879641e+01, 1.79258772950371181e-01,
+     2.68067772490389322e-03, 1.62824170038242295e-03, -9.51592254519715870e-05,
+     5.15138902046611451e-05],
+])
+
+
+def nbody_state():
+    b = NBODY_BODIES
+    pos = b[:, :3].copy()
+    vel = b[:, 3:6] * DAYS_PER_YEAR
+    mass = b[:, 6] * SOLAR_MASS
+    # the benchmark first removes the total momentum through the Sun
+    vel[0] -= (mass[:, None] * vel).sum(axis=0) / mass[0]
+    return pos, vel, mass
+
+
+def _timed(fn):
+    start = time.perf_counter()
+    fn()
+    return time.perf_counter() - start
+
+
+def side_by_side(ours, reference, repeats):
+    """Median of per-repetition ratios reference/ours, and the median times."""
+    t_ours, t_ref, ratios = [], [], []
+    for _ in range(repeats):
+        a = _timed(ours)
+        b = _timed(reference)
+        t_ours.append(a)
+        t_ref.append(b)
+        ratios.append(b / a)
+    return statistics.median(t_ours), statistics.median(t_ref), statistics.median(ratios)
+
+
+# -- 1. direct-sum gravity ---------------------------------------------------------------
+def _cluster(n, seed=1):
+    rng = np.random.default_rng(seed)
+    return (np.full(n, 1.0 / n), rng.normal(size=(n, 3)), rng.normal(size=(n, 3)) * 0.1)
+
+
+def _engine_nbody(n, integrator="leapfrog", dt=1e-4, softening=0.01):
+    from engine import Simulation, forces
+
+    mass, pos, vel = _cluster(n)
+    sim = Simulation(dim=3, integrator=integrator, dt=dt, capacity=n)
+    sim.add_many(mass=mass, pos=pos, vel=vel)
+    sim.add_force(forces.NBodyGravity(softening=softening))
+    sim.step(1)  # compile / load
+    return sim
+
+
+def _rebound_nbody(n, dt=1e-4, softening=0.01):
+    import rebound
+
+    mass, pos, vel = _cluster(n)
+    sim = rebound.Simulation()
+    sim.integrator = "leapfrog"
+    sim.gravity = "basic"
+    sim.softening = softening
+    sim.dt = dt
+    for i in range(n):
+        sim.add(m=mass[i], x=pos[i, 0], y=pos[i, 1], z=pos[i, 2],
+                vx=vel[i, 0], vy=vel[i, 1], vz=vel[i, 2])
+    sim.steps(1)
+    return sim
+
+
+def _machine_pair_bound(n=4096, repeats=3):
+    """Pair evaluations per second of the bare inner loop (the vectorised direct sum of the
+    engine's large-N kernel on contiguous arrays, no bookkeeping): what this CPU can do."""
+    from engine.forces import pairwise
+
+    rng = np.random.default_rng(0)
+    x, y, z = rng.normal(size=(3, n))
+    ones = np.ones(n)
+    beta = np.full(n, 1.0 / n)
+    out = [np.empty(n) for _ in range(3)]
+    pairwise.field(x, y, z, ones, beta, n, 1e-4, 0.0, *out)
+    best = min(_timed(lambda: pairwise.field(x, y, z, ones, beta, n, 1e-4, 0.0, *out))
+               for _ in range(repeats))
+    return n * (n - 1) / best
+
+
+def bench_direct_sum(sizes, repeats):
+    rows = []
+    bound = _machine_pair_bound()
+    for n in sizes:
+        steps = max(1, int(2e7 / (n * n)))
+        ours = _engine_nbody(n)
+        ref = _rebound_nbody(n)
+        t_ours, t_ref, ratio = side_by_side(lambda: ours.step(steps), lambda: ref.steps(steps),
+                                            repeats)
+        per_step = t_ours / steps
+        rows.append({
+            "n": n, "steps": steps, "engine_ms_per_step": 1e3 * per_step,
+            "rebound_ms_per_step": 1e3 * t_ref / steps, "speedup_vs_rebound": ratio,
+            # each unique pair is one interaction (the large-N kernel visits it from both ends)
+            "pairs_per_second": n * (n - 1) / 2 / per_step,
+            "fraction_of_machine_bound": (n * (n - 1) / per_step) / bound,
+        })
+    return {"machine_pair_visits_per_second": bound, "rows": rows}
+
+
+# -- 2. the Benchmarks Game n-body ------------------------------------------------------
+def _plain_loop():
+    from numba import njit
+
+    @njit(cache=False)
+    def advance(pos, vel, mass, steps, dt):
+        n = mass.shape[0]
+        for _ in range(steps):
+            for i in range(n):
+                for j in range(i + 1, n):
+                    dx = pos[i, 0] - pos[j, 0]
+                    dy = pos[i, 1] - pos[j, 1]
+                    dz = pos[i, 2] - pos[j, 2]
+                    d2 = dx * dx + dy * dy + dz * dz
+                    mag = dt / (d2 * math.sqrt(d2))
+                    mj = mass[j] * mag
+                    mi = mass[i] * mag
+                    vel[i, 0] -= dx * mj
+                    vel[i, 1] -= dy * mj
+                    vel[i, 2] -= dz * mj
+                    vel[j, 0] += dx * mi
+                    vel[j, 1] += dy * mi
+                    vel[j, 2] += dz * mi
+            for i in range(n):
+                pos[i, 0] += dt * vel[i, 0]
+                pos[i, 1] += dt * vel[i, 1]
+                pos[i, 2] += dt * vel[i, 2]
+
+    return advance
+
+
+def bench_small_n(steps, repeats):
+    import rebound
+    from engine import Simulation, forces
+
+    pos, vel, mass = nbody_state()
+    sim = Simulation(dim=3, integrator="symplectic_euler", dt=0.01)
+    sim.add_many(mass=mass, pos=pos, vel=vel)
+    sim.add_force(forces.NBodyGravity())
+    sim.step(10)
+    plain = _plain_loop()
+    p, v = pos.copy(), vel.copy()
+    plain(p, v, mass, 10, 0.01)
+    reb = rebound.Simulation()
+    reb.integrator = "leapfrog"  # one force evaluation per step, like symplectic Euler
+    reb.dt = 0.01
+    for i in range(5):
+        reb.add(m=mass[i], x=pos[i, 0], y=pos[i, 1], z=pos[i, 2], vx=vel[i, 0], vy=vel[i, 1],
+                vz=vel[i, 2])
+    reb.steps(10)
+    t_sim, t_plain, vs_plain = side_by_side(lambda: sim.step(steps),
+                                            lambda: plain(p, v, mass, steps, 0.01), repeats)
+    _, t_reb, vs_reb = side_by_side(lambda: sim.step(steps), lambda: reb.steps(steps), repeats)
+    # the engine's result is the same computation as the plain loop's
+    check = Simulation(dim=3, integrator="symplectic_euler", dt=0.01)
+    check.add_many(mass=mass, pos=pos, vel=vel)
+    check.add_force(forces.NBodyGravity())
+    check.step(1000)
+    p2, v2 = pos.copy(), vel.copy()
+    plain(p2, v2, mass, 1000, 0.01)
+    return {
+        "steps": steps,
+        "engine_steps_per_second": steps / t_sim,
+        "plain_loop_steps_per_second": steps / t_plain,
+        "rebound_leapfrog_steps_per_second": steps / t_reb,
+        "engine_time_over_plain_loop": 1.0 / vs_plain,
+        "speedup_vs_rebound": vs_reb,
+        "max_position_difference_vs_plain_after_1000_steps": float(np.abs(check.pos - p2).max()),
+    }
+
+
+# -- 3. scaling ---------------------------------------------------------------------------
+def _time_per_step(sim, budget=0.25):
+    steps = 1
+    while True:
+        t = _timed(lambda: sim.step(steps))
+        if t > budget or steps > 1 << 20:
+            return t / steps
+        steps *= 4
+
+
+def bench_scaling(max_n):
+    from engine import Simulation, forces
+
+    sizes = [2 ** k for k in range(1, int(math.log2(max_n)) + 1)]
+    direct, tests = [], []
+    for n in sizes:
+        direct.append(_time_per_step(_engine_nbody(n)))
+        rng = np.random.default_rng(n)
+        sim = Simulation(dim=3, integrator="leapfrog", dt=1e-3, capacity=n + 4)
+        sim.add_many(mass=1.0, pos=rng.normal(size=(4, 3)) * 3)
+        sim.add_many(mass=0.0, pos=rng.normal(size=(n, 3)) * 10, test=True)
+        sim.add_force(forces.NBodyGravity(softening=0.01))
+        sim.step(1)
+        tests.append(_time_per_step(sim))
+
+    def slope(ns, ts, smallest):
+        keep = [i for i, n in enumerate(ns) if n >= smallest]
+        return float(np.polyfit(np.log(np.array(ns)[keep]), np.log(np.array(ts)[keep]), 1)[0])
+
+    return {"n": sizes, "direct_seconds_per_step": direct, "test_seconds_per_step": tests,
+            "direct_slope_large_n": slope(sizes, direct, 1024),
+            "test_particle_slope_large_n": slope(sizes, tests, 1024)}
+
+
+# -- 4. declared terms ----------------------------------------------------------------------
+def bench_terms(n=128, repeats=5):
+    from engine import Simulation, forces
+
+    sets = {
+        "1: gravity": lambda: [forces.NBodyGravity(softening=0.01)],
+        "2: + drag": lambda: [forces.NBodyGravity(softening=0.01), forces.Drag(linear=0.01)],
+        "4: + uniform gravity, Coulomb": lambda: [
+            forces.NBodyGravity(softening=0.01), forces.Drag(linear=0.01),
+            forces.UniformGravity(g=(0.0, -1.0, 0.0)), forces.Coulomb(k=0.1, softening=0.01)],
+    }
+    out = {}
+    mass, pos, vel = _cluster(n)
+    charge = np.random.default_rng(2).choice([-1.0, 1.0], n)
+    for name, make in sets.items():
+        sim = Simulation(dim=3, integrator="leapfrog", dt=1e-4)
+        sim.add_many(mass=mass, pos=pos, vel=vel, charge=charge)
+        for term in make():
+            sim.add_force(term)
+        sim.step(1)
+        out[name] = statistics.median(_time_per_step(sim, budget=0.1) for _ in range(repeats))
+    base = out["1: gravity"]
+    return {"n": n, "seconds_per_step": out,
+            "relative_to_gravity_alone": {k: v / base for k, v in out.items()}}
+
+
+# -- 5. start-up ------------------------------------------------------------------------------
+_STARTUP = """
+import time
+t0 = time.perf_counter()
+import engine
+from engine import Simulation, forces
+sim = Simulation(dim=3, integrator="leapfrog", dt=0.01)
+sim.add_many(mass=[1.0, 1e-3], pos=[(0, 0, 0), (1, 0, 0)], vel=[(0, 0, 0), (0, 1, 0)])
+sim.add_force(forces.NBodyGravity())
+sim.step(1)
+print(time.perf_counter() - t0)
+"""
+
+
+def bench_startup():
+    def run(env):
+        out = subprocess.run([sys.executable, "-c", _STARTUP], env=env, capture_output=True,
+                             text=True, check=True)
+        return float(out.stdout.strip().splitlines()[-1])
+
+    env = dict(os.environ)
+    with tempfile.TemporaryDirectory() as cold:
+        env["NUMBA_CACHE_DIR"] = cold
+        cold_s = run(env)
+        warm_s = run(env)  # the same (now filled) cache
+    return {"cold_cache_seconds": cold_s, "warm_cache_seconds": warm_s}
+
+
+# -- 6. Spacewar -------------------------------------------------------------------------------
+def bench_spacewar(matches=256, frames=2000):
+    from spacewar import Game, Rules
+    from spacewar.match import play_match
+
+    result, _, timing = play_match("chaser", "sniper", seed=1, rounds=3)
+    rng = np.random.default_rng(0)
+    game = Game(Rules(), seeds=range(matches), rounds=1000)
+    game.step(rng.integers(0, 48, size=(matches, 2)))
+    codes = rng.integers(0, 48, size=(frames, matches, 2))
+    start = time.perf_counter()
+    for f in range(frames):
+        game.step(codes[f])
+    batch = time.perf_counter() - start
+    single = Game(Rules(), seeds=[0], rounds=1000)
+    start = time.perf_counter()
+    for f in range(frames):
+        single.step(codes[f, :1])
+    alone = time.perf_counter() - start
+    return {
+        "one_match_with_bots": {"bots": result["bots"], "frames": result["steps"],
+                                "frames_per_second": timing["frames_per_second"]},
+        "one_match_no_bots_frames_per_second": frames / alone,
+        "batch": {"matches": matches, "frames": frames,
+                  "match_frames_per_second": matches * frames / batch},
+    }
+
+
+# -- the machine --------------------------------------------------------------------------------
+def machine():
+    import numba
+
+    cpu = platform.processor() or ""
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    cpu = line.split(":", 1)[1].strip()
+                    break
+    except OSError:
+        pass
+    info = {"cpu": cpu, "cores": os.cpu_count(), "numba_threads": numba.get_num_threads(),
+            "python": platform.python_version(), "numpy": np.__version__,
+            "numba": numba.__version__, "platform": platform.platform()}
+    try:
+        import llvmlite.binding as llvm
+
+        info["llvm_cpu"] = llvm.get_host_cpu_name()
+    except Exception:  # informational only
+        pass
+    try:
+        import rebound
+
+        info["rebound"] = rebound.__version__
+    except ImportError:
+        pass
+    return info
+
+
+def run(quick=False, sections=None):
+    sections = sections or ["direct", "small", "scaling", "terms", "startup", "spacewar"]
+    repeats = 3 if quick else 7
+    report = {"machine": machine(), "quick": quick}
+    if "direct" in sections:
+        report["direct_sum"] = bench_direct_sum([256, 1024] if quick else [256, 1024, 4096], repeats)
+    if "small" in sections:
+        report["small_n"] = bench_small_n(100_000 if quick else 400_000, repeats)
+    if "scaling" in sections:
+        report["scaling"] = bench_scaling(2048 if quick else 16384)
+    if "terms" in sections:
+        report["terms"] = bench_terms(repeats=3 if quick else 5)
+    if "startup" in sections:
+        report["startup"] = bench_startup()
+    if "spacewar" in sections:
+        report["spacewar"] = bench_spacewar(64 if quick else 256, 500 if quick else 2000)
+    return report
+
+
+def format_report(r):
+    lines = [f"machine: {r['machine']['cpu']}, {r['machine']['cores']} cores, numba "
+             f"{r['machine']['numba']} ({r['machine']['numba_threads']} threads), numpy "
+             f"{r['machine']['numpy']}, REBOUND {r['machine'].get('rebound', '-')}"]
+    if "direct_sum" in r:
+        d = r["direct_sum"]
+        lines.append("\n1. direct-sum gravity, leapfrog (median of side-by-side repetitions)")
+        lines.append(f"{'N':>6}{'engine ms/step':>16}{'REBOUND ms/step':>17}{'speed-up':>10}"
+                     f"{'pairs/s':>11}{'of bound':>10}")
+        for row in d["rows"]:
+            lines.append(f"{row['n']:>6}{row['engine_ms_per_step']:>16.3f}"
+                         f"{row['rebound_ms_per_step']:>17.3f}{row['speedup_vs_rebound']:>9.1f}x"
+                         f"{row['pairs_per_second']:>11.2e}{row['fraction_of_machine_bound']:>9.0%}")
+        lines.append(f"machine bound (bare vectorised loop, all cores): "
+                     f"{d['machine_pair_visits_per_second']:.2e} pair visits/s")
+    if "small_n" in r:
+        s = r["small_n"]
+        lines.append("\n2. Benchmarks Game n-body (5 bodies, symplectic Euler, dt = 0.01)")
+        lines.append(f"engine sim.step(n): {s['engine_steps_per_second']:.3e} steps/s; plain numba "
+                     f"loop: {s['plain_loop_steps_per_second']:.3e}; REBOUND leapfrog: "
+                     f"{s['rebound_leapfrog_steps_per_second']:.3e}")
+        lines.append(f"engine time / plain loop: {s['engine_time_over_plain_loop']:.2f}; "
+                     f"speed-up vs REBOUND: {s['speedup_vs_rebound']:.2f}x; same result to "
+                     f"{s['max_position_difference_vs_plain_after_1000_steps']:.1e}")
+    if "scaling" in r:
+        s = r["scaling"]
+        lines.append("\n3. scaling (seconds per leapfrog step)")
+        lines.append(f"{'N':>7}{'direct':>12}{'N_test':>12}")
+        for n, a, b in zip(s["n"], s["direct_seconds_per_step"], s["test_seconds_per_step"]):
+            lines.append(f"{n:>7}{a:>12.2e}{b:>12.2e}")
+        lines.append(f"fitted slopes (N >= 1024): direct {s['direct_slope_large_n']:.2f}, "
+                     f"test particles {s['test_particle_slope_large_n']:.2f}")
+    if "terms" in r:
+        t = r["terms"]
+        lines.append(f"\n4. declared terms (N = {t['n']}, leapfrog)")
+        for k, v in t["seconds_per_step"].items():
+            lines.append(f"  {k:<34}{v * 1e6:>9.1f} us/step  ({t['relative_to_gravity_alone'][k]:.2f}x)")
+    if "startup" in r:
+        s = r["startup"]
+        lines.append(f"\n5. start-up (import engine + first step): warm cache "
+                     f"{s['warm_cache_seconds']:.2f} s, cold cache {s['cold_cache_seconds']:.1f} s")
+    if "spacewar" in r:
+        s = r["spacewar"]
+        one = s["one_match_with_bots"]
+        lines.append(f"\n6. Spacewar: one match {one['bots'][0]} vs {one['bots'][1]} with bots "
+                     f"{one['frames_per_second']:.0f} frames/s; without bots "
+                     f"{s['one_match_no_bots_frames_per_second']:.0f} frames/s; "
+                     f"{s['batch']['matches']} matches together "
+                     f"{s['batch']['match_frames_per_second']:.3e} match-frames/s")
+    return "\n".join(lines)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(prog="python -m validation bench",
+                                     description="Measure the engine's speed against references.")
+    parser.add_argument("--quick", action="store_true", help="smaller sizes, fewer repetitions")
+    parser.add_argument("--json", metavar="FILE", help="also write the results as JSON")
+    parser.add_argument("--only", metavar="SECTIONS",
+                        help="comma-separated: direct,small,scaling,terms,startup,spacewar")
+    args = parser.parse_args(argv)
+    sections = args.only.split(",") if args.only else None
+    report = run(quick=args.quick, sections=sections)
+    print(format_report(report))
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump(report, f, indent=2, sort_keys=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
