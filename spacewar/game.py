@@ -193,7 +193,7 @@ class Game:
                     hyperspace=int(i[core.HYPER_LEFT]), alive=bool(i[core.ALIVE]),
                     in_hyperspace=bool(i[core.IN_HYPER]), reload=int(i[core.RELOAD]),
                     hyperspace_recharge=int(i[core.HYPER_RECHARGE]),
-                    charge=float(self.charge[m, s]))
+                    charge=float(self.charge[m, s]), flip_cooldown=int(i[core.FLIP_CD]))
 
     def observe(self, m, seat):
         """The observation of match ``m`` from seat ``seat``'s side."""
@@ -233,7 +233,7 @@ class Game:
                 np.sin(ship.heading), ship.angular_velocity, ship.fuel / max(r.fuel, 1e-300),
                 ship.torpedoes / r.torpedoes, ship.hyperspace / max(r.hyperspace_jumps, 1),
                 float(ship.alive), float(ship.in_hyperspace), ship.reload / max(r.reload, 1),
-                float(np.sign(ship.charge))]
+                float(np.sign(ship.charge)), ship.flip_cooldown / max(r.flip_cooldown, 1)]
 
     def snapshot(self, m=0):
         """Plain data for drawing match ``m``: ships, torpedoes, score, frame."""

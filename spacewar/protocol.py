@@ -65,6 +65,7 @@ class Ship:
     reload: int  # frames until the next torpedo may be fired
     hyperspace_recharge: int
     charge: float
+    flip_cooldown: int  # frames until the polarity may be flipped again (electric mode)
 
 
 @dataclass(frozen=True)
@@ -102,7 +103,7 @@ class Observation:
 #: names of the entries of ``Observation.vector()``, in order
 SHIP_FIELDS = ("x", "y", "vx", "vy", "cos_heading", "sin_heading", "angular_velocity",
                "fuel_fraction", "torpedo_fraction", "hyperspace_fraction", "alive",
-               "in_hyperspace", "reload_fraction", "charge_sign")
+               "in_hyperspace", "reload_fraction", "charge_sign", "flip_cooldown_fraction")
 TORPEDO_FIELDS = ("present", "x", "y", "vx", "vy", "mine", "ttl_fraction")
 
 

@@ -373,3 +373,22 @@ def test_batched_matches_equal_single_runs_bit_for_bit():
             g.step(codes[f, m][None, :])
     for m, g in enumerate(singles):
         assert batch.state_hash(m) == g.state_hash(0)
+
+
+def test_observation_vector_matches_its_layout_and_the_views():
+    from spacewar.protocol import vector_layout
+
+    rules = Rules(mode="electric")
+    g = Game(rules)
+    run(g, [FIRE, FLIP], 1)
+    obs = g.observe(0, 1)
+    names = vector_layout(rules)
+    v = obs.vector()
+    assert v.shape == (len(names),) and np.all(np.isfinite(v))
+    value = dict(zip(names, v))
+    assert value["me.x"] == obs.me.pos[0] and value["enemy.x"] == obs.enemy.pos[0]
+    assert obs.me.flip_cooldown == rules.flip_cooldown and value["me.flip_cooldown_fraction"] == 1.0
+    assert value["me.charge_sign"] == 1.0  # seat 1 started negative and flipped
+    # ship 0's torpedo is the enemy's from seat 1's side: in the second half of the slots
+    assert value[f"torpedo{rules.torpedoes}.present"] == 1.0 and value[f"torpedo{rules.torpedoes}.mine"] == 0.0
+    assert len(obs.torpedoes) == 1 and not obs.torpedoes[0].mine
