@@ -10,6 +10,8 @@ numba's setting is switched while they are imported and restored afterwards.
 import contextlib
 import hashlib
 import os
+import shutil
+import time
 from pathlib import Path
 
 _ROOT = Path(__file__).resolve().parent.parent
@@ -25,6 +27,10 @@ def _source_hash():
     return digest.hexdigest()[:16]
 
 
+KEEP = 6  # compiled-code directories kept (for the sources seen most recently) ...
+MIN_AGE = 24 * 3600  # ... and none younger than a day is removed (a long run may be using it)
+
+
 def cache_dir():
     """The directory of this project's compiled code for the current sources."""
     base = os.environ.get("NUMBA_CACHE_DIR") or os.path.join(
@@ -33,13 +39,36 @@ def cache_dir():
     return os.path.join(base, "numba-" + _source_hash())
 
 
+def prune(current):
+    """Remove all but the most recently used compiled-code directories beside ``current``."""
+    parent = os.path.dirname(current)
+    try:
+        entries = [os.path.join(parent, d) for d in os.listdir(parent) if d.startswith("numba-")]
+        entries.sort(key=os.path.getmtime, reverse=True)
+    except OSError:
+        return
+    now = time.time()
+    for old in entries[KEEP:]:
+        try:
+            stale = now - os.path.getmtime(old) > MIN_AGE
+        except OSError:
+            continue
+        if old != current and stale:
+            shutil.rmtree(old, ignore_errors=True)
+
+
 @contextlib.contextmanager
 def project_cache():
     """Import the project's compiled modules inside this block."""
     from numba.core import config
 
     previous = config.CACHE_DIR
-    config.CACHE_DIR = cache_dir()
+    current = cache_dir()
+    if os.path.isdir(current):
+        os.utime(current)  # mark it recently used, so pruning keeps it
+    else:
+        prune(current)
+    config.CACHE_DIR = current
     try:
         yield
     finally:

@@ -42,6 +42,14 @@ def _play(job):
     return result, timing
 
 
+def _warm_up(rules):
+    """Compile (or load) the game's code here, once, before the workers start: workers then
+    only read numba's cache instead of all compiling and writing it at the same time."""
+    from .game import Game
+
+    Game(rules, seeds=[0], rounds=1).step()
+
+
 def bradley_terry_elo(names, results, iterations=2000):
     """Elo-scale ratings from (p1, p2, outcome) with outcome 1, 0.5 or 0 for p1."""
     k = len(names)
@@ -85,6 +93,8 @@ def run_tournament(bots, games=10, seed=1, rounds=3, rules=None, workers=None, p
         raise ValueError(f"workers must be an int >= 1, got {workers!r}")
     jobs = [(p1, p2, s, rounds, rules.to_dict(), budget, max_faults, isolation)
             for p1, p2, s in schedule(bots, games, seed)]
+    if workers > 1:
+        _warm_up(rules)
     bar = _progress(len(jobs), progress)
     outcomes = []
     if workers == 1:

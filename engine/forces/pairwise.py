@@ -25,8 +25,11 @@ from numba import njit, prange
 #: reassociation and contraction for vector reductions; never 'nnan'/'ninf' (NaN must survive)
 SIMD_MATH = {"reassoc", "contract", "nsz", "arcp"}
 
-#: below this many interacting particles the plain serial pair loop is faster
+#: from this many particle slots on, the vectorised kernels replace the scalar pair loop
 PARALLEL_MIN = 192
+
+#: from this many interacting particles on, the vectorised kernel also uses every core
+THREADS_MIN = 1024
 
 
 def workspace(n):
@@ -63,25 +66,54 @@ def _span(x, y, z, beta, eps2, box, xi, yi, zi, j0, j1):
     return sx, sy, sz
 
 
-@njit(parallel=True, cache=True, fastmath=SIMD_MATH, error_model="numpy")
-def field(x, y, z, alpha, beta, sources, eps2, box, ax, ay, az):
-    """a_c = alpha_c sum_{j < sources, j != c} beta_j d / r^3 for every particle c.
+@njit(cache=True, fastmath=SIMD_MATH, error_model="numpy", inline="always")
+def _target(c, x, y, z, alpha, beta, sources, eps2, box, ax, ay, az):
+    """a_c = alpha_c sum_{j < sources, j != c} beta_j d / r^3 (particle c is skipped as its
+    own source by splitting the range, never by a branch in the loop)."""
+    xi = x[c]
+    yi = y[c]
+    zi = z[c]
+    sx, sy, sz = _span(x, y, z, beta, eps2, box, xi, yi, zi, 0, min(c, sources))
+    if c + 1 < sources:
+        tx, ty, tz = _span(x, y, z, beta, eps2, box, xi, yi, zi, c + 1, sources)
+        sx += tx
+        sy += ty
+        sz += tz
+    ax[c] = alpha[c] * sx
+    ay[c] = alpha[c] * sy
+    az[c] = alpha[c] * sz
 
-    Particles [0, sources) are the sources; the others only feel the field (test particles).
-    """
+
+# One explicit signature each: a parallel function is compiled into a kernel whose symbol every
+# cached caller links against; two specialisations of it (C and A layouts) in one cache were
+# seen to let a caller pick the wrong kernel and crash. So there is exactly one.
+_ARR = "float64[::1]"
+_FIELD_SIGNATURE = f"void({', '.join([_ARR] * 5)}, int64, float64, float64, {', '.join([_ARR] * 3)})"
+
+
+@njit(_FIELD_SIGNATURE, parallel=True, cache=True, fastmath=SIMD_MATH, error_model="numpy")
+def field(x, y, z, alpha, beta, sources, eps2, box, ax, ay, az):
+    """Every particle's field from particles [0, sources), targets spread over all cores.
+
+    Particles from ``sources`` on only feel the field (test particles)."""
     for c in prange(x.shape[0]):
-        xi = x[c]
-        yi = y[c]
-        zi = z[c]
-        sx, sy, sz = _span(x, y, z, beta, eps2, box, xi, yi, zi, 0, min(c, sources))
-        if c + 1 < sources:
-            tx, ty, tz = _span(x, y, z, beta, eps2, box, xi, yi, zi, c + 1, sources)
-            sx += tx
-            sy += ty
-            sz += tz
-        ax[c] = alpha[c] * sx
-        ay[c] = alpha[c] * sy
-        az[c] = alpha[c] * sz
+        _target(c, x, y, z, alpha, beta, sources, eps2, box, ax, ay, az)
+
+
+@njit(_FIELD_SIGNATURE, cache=True, fastmath=SIMD_MATH, error_model="numpy")
+def field_serial(x, y, z, alpha, beta, sources, eps2, box, ax, ay, az):
+    """``field`` on one core: for mid-sized systems, where waking the other threads for each
+    evaluation costs more than it saves (and a busy machine can stall a parallel region)."""
+    for c in range(x.shape[0]):
+        _target(c, x, y, z, alpha, beta, sources, eps2, box, ax, ay, az)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _field(x, y, z, alpha, beta, sources, eps2, box, ax, ay, az):
+    if x.shape[0] >= THREADS_MIN:
+        field(x, y, z, alpha, beta, sources, eps2, box, ax, ay, az)
+    else:
+        field_serial(x, y, z, alpha, beta, sources, eps2, box, ax, ay, az)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -127,7 +159,7 @@ def gravity(pos, mass, active, test, n, G, eps2, box, acc, work, iwork):
     for c in range(m):
         work[3 * m + c] = 1.0
         work[4 * m + c] = G * mass[iwork[c]]
-    field(work[0:m], work[m:2 * m], work[2 * m:3 * m], work[3 * m:4 * m], work[4 * m:5 * m], src,
+    _field(work[0:m], work[m:2 * m], work[2 * m:3 * m], work[3 * m:4 * m], work[4 * m:5 * m], src,
           eps2, box, work[5 * m:6 * m], work[6 * m:7 * m], work[7 * m:8 * m])
     _scatter(acc, iwork, m, work)
 
@@ -145,6 +177,6 @@ def coulomb(pos, mass, charge, active, n, k_e, eps2, box, acc, work, iwork):
         i = iwork[c]
         work[3 * m + c] = -k_e * charge[i] / mass[i]
         work[4 * m + c] = charge[i]
-    field(work[0:m], work[m:2 * m], work[2 * m:3 * m], work[3 * m:4 * m], work[4 * m:5 * m], m,
+    _field(work[0:m], work[m:2 * m], work[2 * m:3 * m], work[3 * m:4 * m], work[4 * m:5 * m], m,
           eps2, box, work[5 * m:6 * m], work[6 * m:7 * m], work[7 * m:8 * m])
     _scatter(acc, iwork, m, work)
