@@ -1,0 +1,28 @@
+"""``python -m validation report --out DIR [--quick]`` | ``python -m validation bench ...``"""
+import argparse
+import sys
+
+
+def main(argv=None):
+    argv = list(sys.argv[1:] if argv is None else argv)
+    parser = argparse.ArgumentParser(
+        prog="python -m validation",
+        description="Validation of the engine against REBOUND and closed forms, and benchmarks.")
+    sub = parser.add_subparsers(dest="command", metavar="{report,bench}")
+    sub.add_parser("report", add_help=False,
+                   help="orbits, energy drift, work-precision and hard cases: DIR/report.md")
+    sub.add_parser("bench", add_help=False, help="benchmarks")
+    if not argv or argv[0] not in ("report", "bench"):
+        parser.parse_args(argv)  # prints usage / help, or the error for an unknown command
+        parser.print_help()
+        return 2
+    command, rest = argv[0], argv[1:]
+    if command == "report":
+        from . import report
+        return report.main(rest)
+    from . import bench  # written separately; imported only when asked for
+    return bench.main(rest)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,193 @@
+"""The report's figures (matplotlib, Agg backend: no display needed)."""
+import math
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+STYLE = {
+    "engine:euler": ("tab:red", "-", "o"),
+    "engine:symplectic_euler": ("tab:orange", "-", "v"),
+    "engine:leapfrog": ("tab:blue", "-", "s"),
+    "engine:verlet": ("tab:cyan", "-", "^"),
+    "engine:rk4": ("tab:purple", "-", "D"),
+    "engine:yoshida4": ("tab:green", "-", "P"),
+    "engine:pefrl": ("tab:olive", "-", "X"),
+    "engine:rk45": ("tab:brown", "-", "*"),
+    "rebound:ias15": ("black", "--", "o"),
+    "rebound:whfast": ("dimgray", "--", "s"),
+    "rebound:leapfrog": ("navy", "--", "^"),
+    "rebound:saba": ("magenta", "--", "D"),
+}
+
+
+def label(method):
+    code, name = method.split(":")
+    return name if code == "engine" else f"REBOUND {name}"
+
+
+def _style(method):
+    return STYLE.get(method, ("gray", ":", "."))
+
+
+def _save(fig, path):
+    fig.savefig(path, dpi=110, bbox_inches="tight")
+    plt.close(fig)
+
+
+def _grid(n, width=4.6, height=3.6, cols=3):
+    cols = min(cols, n)
+    rows = math.ceil(n / cols)
+    fig, axes = plt.subplots(rows, cols, figsize=(width * cols, height * rows), squeeze=False,
+                             layout="constrained")
+    for ax in axes.flat[n:]:
+        ax.set_visible(False)
+    return fig, list(axes.flat[:n])
+
+
+def _figure_legend(fig, axes):
+    """One legend for all panels, from every panel's lines (without duplicates)."""
+    seen = {}
+    for ax in axes:
+        for h, lab in zip(*ax.get_legend_handles_labels()):
+            seen.setdefault(lab, h)
+    fig.legend(list(seen.values()), list(seen), loc="outside lower center", ncol=5, fontsize=8)
+
+
+def two_body_convergence(section, path, checkpoint_index=1):
+    """Position error after the second checkpoint against steps per orbit."""
+    keys = list(section)
+    fig, axes = _grid(len(keys))
+    for ax, key in zip(axes, keys):
+        entry = section[key]
+        cp = entry["checkpoints"][min(checkpoint_index, len(entry["checkpoints"]) - 1)]
+        by_method = {}
+        for run in entry["runs"]:
+            if "steps_per_orbit" not in run:
+                continue
+            err = run["pos_err_kepler"][min(checkpoint_index, len(run["pos_err_kepler"]) - 1)]
+            if err is None:
+                continue
+            point = (run["steps_per_orbit"], max(err, 1e-17))
+            by_method.setdefault(run["method"], []).append(point)
+        for method, pts in by_method.items():
+            pts.sort()
+            c, ls, mk = _style(method)
+            ax.loglog(*zip(*pts), ls=ls, marker=mk, color=c, label=label(method), ms=4)
+        ax.set_title(f"{entry['title']}: after {cp} P")
+        ax.set_xlabel("steps per P")
+        ax.set_ylabel("|r - r_kepler| / max(|r_kepler|, |a|)")
+        ax.grid(True, which="both", alpha=0.3)
+    _figure_legend(fig, axes)
+    _save(fig, path)
+
+
+def two_body_growth(section, path, steps_per_orbit):
+    """Position error against time at one step setting (rk45 at its middle tolerance)."""
+    keys = list(section)
+    fig, axes = _grid(len(keys))
+    for ax, key in zip(axes, keys):
+        entry = section[key]
+        tols = sorted({r["tolerance"] for r in entry["runs"] if "tolerance" in r})
+        mid_tol = tols[len(tols) // 2] if tols else None
+        for run in entry["runs"]:
+            if run.get("steps_per_orbit") != steps_per_orbit and run.get("tolerance") != mid_tol:
+                continue
+            pts = [(t, max(e, 1e-17)) for t, e in zip(entry["checkpoints"], run["pos_err_kepler"])
+                   if e is not None]
+            if not pts:
+                continue
+            c, ls, mk = _style(run["method"])
+            name = label(run["method"]) + (f" tol {mid_tol:g}" if "tolerance" in run else "")
+            ax.loglog(*zip(*pts), ls=ls, marker=mk, color=c, label=name, ms=4)
+        ias = entry["ias15_vs_kepler"]["pos"]
+        ax.loglog(entry["checkpoints"], [max(e, 1e-17) for e in ias], color="black", ls=":",
+                  marker=".", label="REBOUND ias15 vs Kepler")
+        ax.set_title(f"{entry['title']} ({steps_per_orbit} steps/P)")
+        ax.set_xlabel("time [P]")
+        ax.set_ylabel("|r - r_kepler| / max(|r_kepler|, |a|)")
+        ax.grid(True, which="both", alpha=0.3)
+    _figure_legend(fig, axes)
+    _save(fig, path)
+
+
+def energy_drift(section, path):
+    keys = list(section)
+    fig, axes = _grid(len(keys), width=6.8, height=4.8, cols=2)
+    for ax, key in zip(axes, keys):
+        entry = section[key]
+        unit = entry["time_unit"]
+        for run in entry["runs"]:
+            t = np.asarray(run["t"], dtype=float) / unit
+            e = np.maximum(np.asarray(run["err"], dtype=float), 1e-17)
+            if t.size == 0:
+                continue
+            c, ls, mk = _style(run["method"])
+            slope = run["growth_exponent"]
+            tag = "" if slope is None else f" (slope {0.0 if abs(slope) < 0.005 else slope:.2f})"
+            ax.loglog(t, e, ls=ls, color=c, label=f"{label(run['method'])}, {run['setting']}{tag}",
+                      lw=1.3)
+        ax.set_title(entry["title"])
+        ax.set_xlabel(f"time [{entry['time_unit_name']}]")
+        ax.set_ylabel("|E - E0| / |E0|")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=2)
+    _save(fig, path)
+
+
+#: work-precision points with a larger error (in units of L, or relative energy) are not drawn
+WP_ERROR_CAP = 1e2
+
+
+def work_precision(entry, path):
+    fig, axes = plt.subplots(1, 2, figsize=(12.5, 4.8), layout="constrained")
+    metric = entry["metric"]
+    by_method = {}
+    for run in entry["runs"]:
+        if run.get("error") is None or not run["error"] <= WP_ERROR_CAP:
+            continue
+        by_method.setdefault(run["method"], []).append(run)
+    for method, runs in by_method.items():
+        runs.sort(key=lambda r: r["evaluations"])  # the sweep's own order: cost
+        c, ls, mk = _style(method)
+        err = [max(r["error"], 1e-17) for r in runs]
+        axes[0].loglog(err, [r["time_s"] for r in runs], ls=ls, marker=mk, color=c,
+                       label=label(method), ms=4)
+        axes[1].loglog(err, [max(r["evaluations"], 1) for r in runs], ls=ls, marker=mk, color=c,
+                       label=label(method), ms=4)
+    xlabel = ("|E - E0| / |E0| at t_end" if metric == "energy"
+              else f"max |r - r_ref| / L at t_end (L = {entry['length_name']})")
+    for ax, ylabel in zip(axes, ("wall time [s]", "force evaluations")):
+        ax.set_xlabel(xlabel)
+        ax.set_ylabel(ylabel)
+        ax.grid(True, which="both", alpha=0.3)
+        if metric == "position" and entry["reference"]["floor"] > 0:
+            ax.axvline(entry["reference"]["floor"], color="gray", ls=":", lw=1)
+    axes[0].set_title(f"{entry['title']}: wall time")
+    axes[1].set_title(f"{entry['title']}: force evaluations")
+    handles, labels = axes[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="outside right center", fontsize=8)
+    _save(fig, path)
+
+
+def spring_limits(limits, path):
+    names = [n for n in limits if limits[n]["theory"] is not None]
+    fig, ax = plt.subplots(figsize=(8.5, 3.8))
+    x = np.arange(len(names))
+    theory = [limits[n]["theory"] for n in names]
+    ax.bar(x - 0.2, theory, width=0.4, color="lightgray", edgecolor="black", label="theory")
+    ks = sorted({k for n in names for k in limits[n]["measured"]})
+    for j, k in enumerate(ks):
+        vals = [limits[n]["measured"].get(k, {}).get("limit") or 0.0 for n in names]
+        ax.scatter(x + 0.08 + 0.12 * j, vals, marker="o^sDv"[j % 5], s=36,
+                   label=f"measured, k = {k:g}", zorder=3)
+    ax.set_xticks(x)
+    ax.set_xticklabels(names, rotation=15)
+    ax.set_ylabel("largest stable omega dt")
+    ax.axhline(2.0, color="tab:blue", ls=":", lw=1)
+    ax.set_title("stiff spring: stability limit of each integrator")
+    ax.legend(fontsize=8)
+    ax.grid(True, axis="y", alpha=0.3)
+    _save(fig, path)
