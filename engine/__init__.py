@@ -19,5 +19,5 @@ with project_cache():
 
 __version__ = "0.1.0"
 
-__all__ = ["Simulation", "SimulationError", "INTEGRATORS", "ORDERS", "SYMPLECTIC", "forces",
+__all__ = ["Simulation", "SimulationError", "INTEGRATORS", "ORDERS", "SYMPLECTIC", "forces", "integrators",
            "analytic", "clock", "diagnostics", "FixedStepClock", "__version__"]

@@ -243,7 +243,6 @@ def _hit(pos, m, a, b, box, diamond):
 @njit(cache=True)
 def _collisions(m, pos, vel, active, ship_i, torp_life, mi, rp):
     n = pos.shape[2]
-    ntorp = int(rp[R_NTORP])
     box = rp[R_HITBOX]
     diamond = rp[R_DIAMOND]
     doomed = np.zeros(n, dtype=np.bool_)

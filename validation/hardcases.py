@@ -381,7 +381,7 @@ def flyby_job(integrator, setting):
         else:
             sim = make_sim(p, integrator, setting)
         exc = _run_to(sim, p.t_end)
-        pos, vel, steps = sim.pos, sim.vel, sim.steps
+        vel, steps = sim.vel, sim.steps
     r, v = analytic.kepler(p.pos[0], p.vel[0], 1.0, p.t_end)
     dv = float(np.linalg.norm(vel[0] - v) / np.linalg.norm(v))
     cosang = float(np.dot(vel[0], v) / (np.linalg.norm(vel[0]) * np.linalg.norm(v)))

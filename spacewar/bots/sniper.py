@@ -245,7 +245,7 @@ class Sniper:
 
     def decide(self, obs):
         """The Action of a live ship out of hyperspace."""
-        me, enemy = obs.me, obs.enemy
+        enemy = obs.enemy
         visible = enemy.alive and not enemy.in_hyperspace
         path = self.enemy_path(obs) if visible else None
         escape = self.safety(obs)
