@@ -80,6 +80,15 @@ def _run_to(sim, t_end):
         return exc
 
 
+def _engine_run(p, integrator, setting):
+    """Run problem ``p`` to its end: ``setting`` is the step, or rk45's tolerance."""
+    if integrator == "rk45":
+        sim = make_sim(p, "rk45", 1e-3, tolerance=setting)
+    else:
+        sim = make_sim(p, integrator, setting)
+    return sim, _run_to(sim, p.t_end)
+
+
 # -- e = 0.99 --------------------------------------------------------------------------------------
 
 def e099_job(integrator, setting, orbits):
@@ -134,11 +143,7 @@ def pythagorean_job(integrator, setting, code="engine"):
         pos, vel = run.state()
         energy, steps, exc = run.energy(), int(run.sim.steps_done), None
     else:
-        if integrator == "rk45":
-            sim = make_sim(p, "rk45", 1e-3, tolerance=setting)
-        else:
-            sim = make_sim(p, integrator, setting)
-        exc = _run_to(sim, p.t_end)
+        sim, exc = _engine_run(p, integrator, setting)
         pos, vel, energy, steps = sim.pos.copy(), sim.vel.copy(), sim.energy(), sim.steps
         closest = None
     de = abs(energy - PYTHAGOREAN_ENERGY) / abs(PYTHAGOREAN_ENERGY)
@@ -376,11 +381,7 @@ def flyby_job(integrator, setting):
         pos, vel = run.state()
         steps, exc = int(run.sim.steps_done), None
     else:
-        if integrator == "rk45":
-            sim = make_sim(p, "rk45", 1e-3, tolerance=setting)
-        else:
-            sim = make_sim(p, integrator, setting)
-        exc = _run_to(sim, p.t_end)
+        sim, exc = _engine_run(p, integrator, setting)
         vel, steps = sim.vel, sim.steps
     r, v = analytic.kepler(p.pos[0], p.vel[0], 1.0, p.t_end)
     dv = float(np.linalg.norm(vel[0] - v) / np.linalg.norm(v))
