@@ -26,7 +26,7 @@ def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, i
     eps2 = fp[f0 + 1]
     box = fp[f0 + 2]
     dim = pos.shape[0]
-    if n >= pairwise.PARALLEL_MIN:
+    if pairwise.usable(n, work):
         pairwise.coulomb(pos, mass, charge, active, n, k, eps2, box, acc, work, iwork)
         return
     for i in range(n):

@@ -8,7 +8,8 @@ U = - sum_{i<j} G m_i m_j / sqrt(|p_j - p_i|^2 + eps^2)
 Each pair is visited once and both bodies get equal and opposite forces, so total momentum is
 conserved to round-off. Test particles feel the field but are not sources (so a pair of test
 particles costs nothing: O(N_massive x N) for test particles around a few bodies). From
-``pairwise.PARALLEL_MIN`` particles on, the vectorised multi-core kernel of ``pairwise`` runs.
+``pairwise.PARALLEL_MIN`` particles on, given a workspace, the vectorised multi-core kernel of
+``pairwise`` runs instead (each pair visited from both ends; momentum to round-off per visit).
 """
 import math
 
@@ -67,7 +68,7 @@ def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, i
     G = fp[f0]
     eps2 = fp[f0 + 1]
     box = fp[f0 + 2]
-    if n >= pairwise.PARALLEL_MIN:
+    if pairwise.usable(n, work):
         pairwise.gravity(pos, mass, active, test, n, G, eps2, box, acc, work, iwork)
         return
     three = pos.shape[0] == 3

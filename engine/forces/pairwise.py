@@ -11,9 +11,9 @@ vectorises (8 doubles per AVX-512 instruction), targets spread over all cores.
 
 Why not Newton's third law here, as the small-N kernel does? Writing the reaction into the
 other body inside the loop stops the vectoriser (it cannot prove the arrays do not overlap):
-measured on this project's 2-core machine, the vectorised full sum costs 0.9 ns per pair
-visit against 3.8 ns per pair for the scalar symmetric loop, so it wins even doing each pair
-twice. Each target's sum is independent of the others, so the result does not depend on
+measured on this project's 2-core machine (one core, N = 1024), the vectorised full sum costs
+0.41 ns per pair visit against 4.5 ns per pair for the scalar symmetric loop, so it wins by
+5x even doing each pair twice. Each target's sum is independent of the others, so the result does not depend on
 the number of threads. The loops are compiled with the reassociation vector reductions need,
 never with 'nnan'/'ninf': a singular pair must still produce NaN and be caught.
 """
@@ -26,19 +26,29 @@ from numba import njit, prange
 SIMD_MATH = {"reassoc", "contract", "nsz", "arcp"}
 
 #: from this many particle slots on, the vectorised kernels replace the scalar pair loop
-PARALLEL_MIN = 192
+#: (measured on leapfrog steps: 16 bodies 0.32 us vectorised against 0.57 us scalar at 15;
+#: 8 bodies 0.25 us against 0.21 us)
+PARALLEL_MIN = 12
 
-#: from this many interacting particles on, the vectorised kernel also uses every core
-THREADS_MIN = 1024
+#: from this many interacting particles on, the vectorised kernel also uses every core (a
+#: parallel region costs 3 to 4 us to start: measured break-even between 128 and 256 bodies)
+THREADS_MIN = 192
 
 
 def workspace(n):
     """Scratch arrays for the large-N kernels, made once per ``step(n)`` call (in Python, so
     compiled code never allocates per force evaluation): compacted coordinates, weights and
-    results (8 n floats) and the index map (n ints)."""
+    results (8 n floats) and the index map (n ints). Kernels given a smaller workspace
+    (Spacewar passes none) use the scalar pair loop instead."""
     if n < PARALLEL_MIN:
         return np.empty(0), np.empty(0, dtype=np.int64)
     return np.empty(8 * n), np.empty(n, dtype=np.int64)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def usable(n, work):
+    """Does this call take the vectorised path: enough particles, and a workspace for them?"""
+    return n >= PARALLEL_MIN and work.shape[0] >= 8 * n
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -49,36 +59,31 @@ def _image(d, box):
 
 
 @njit(cache=True, fastmath=SIMD_MATH, error_model="numpy", inline="always")
-def _span(x, y, z, beta, eps2, box, xi, yi, zi, j0, j1):
-    """sum_{j0 <= j < j1} beta_j (p_j - p_i) / r^3: reads only, so it vectorises."""
+def _target(c, x, y, z, alpha, beta, sources, eps2, box, ax, ay, az):
+    """a_c = alpha_c sum_{j < sources, j != c} beta_j d / r^3, in one branch-free pass over
+    the sources that reads only, so it vectorises.
+
+    Particle c is dropped as its own source by a select on the index (a vector compare and
+    blend), not by splitting the range in two: two shorter loops each end in a scalar
+    remainder of up to 31 pairs (8 lanes, 4 interleaved), which measured 2 to 3 times slower
+    at N = 1024. A genuinely coincident pair j != c still gives 0 * inf = NaN and is caught.
+    """
+    xi = x[c]
+    yi = y[c]
+    zi = z[c]
     sx = 0.0
     sy = 0.0
     sz = 0.0
-    for j in range(j0, j1):
+    for j in range(sources):
         dx = _image(x[j] - xi, box)
         dy = _image(y[j] - yi, box)
         dz = _image(z[j] - zi, box)
         r2 = dx * dx + dy * dy + dz * dz + eps2
         bj = beta[j] / (r2 * math.sqrt(r2))
+        bj = 0.0 if j == c else bj
         sx += bj * dx
         sy += bj * dy
         sz += bj * dz
-    return sx, sy, sz
-
-
-@njit(cache=True, fastmath=SIMD_MATH, error_model="numpy", inline="always")
-def _target(c, x, y, z, alpha, beta, sources, eps2, box, ax, ay, az):
-    """a_c = alpha_c sum_{j < sources, j != c} beta_j d / r^3 (particle c is skipped as its
-    own source by splitting the range, never by a branch in the loop)."""
-    xi = x[c]
-    yi = y[c]
-    zi = z[c]
-    sx, sy, sz = _span(x, y, z, beta, eps2, box, xi, yi, zi, 0, min(c, sources))
-    if c + 1 < sources:
-        tx, ty, tz = _span(x, y, z, beta, eps2, box, xi, yi, zi, c + 1, sources)
-        sx += tx
-        sy += ty
-        sz += tz
     ax[c] = alpha[c] * sx
     ay[c] = alpha[c] * sy
     az[c] = alpha[c] * sz
@@ -88,36 +93,46 @@ def _target(c, x, y, z, alpha, beta, sources, eps2, box, ax, ay, az):
 # cached caller links against; two specialisations of it (C and A layouts) in one cache were
 # seen to let a caller pick the wrong kernel and crash. So there is exactly one.
 _ARR = "float64[::1]"
-_FIELD_SIGNATURE = f"void({', '.join([_ARR] * 5)}, int64, float64, float64, {', '.join([_ARR] * 3)})"
+_FIELD_SIGNATURE = f"void({', '.join([_ARR] * 5)}, int64, int64, float64, float64, {', '.join([_ARR] * 3)})"
 
 
 @njit(_FIELD_SIGNATURE, parallel=True, cache=True, fastmath=SIMD_MATH, error_model="numpy")
-def field(x, y, z, alpha, beta, sources, eps2, box, ax, ay, az):
-    """Every particle's field from particles [0, sources), targets spread over all cores.
-
-    Particles from ``sources`` on only feel the field (test particles)."""
-    for c in prange(x.shape[0]):
+def field(x, y, z, alpha, beta, targets, sources, eps2, box, ax, ay, az):
+    """The field on particles [0, targets) from particles [0, sources), targets spread over
+    all cores. Particles from ``sources`` on only feel the field (test particles)."""
+    for c in prange(targets):
         _target(c, x, y, z, alpha, beta, sources, eps2, box, ax, ay, az)
 
 
 @njit(_FIELD_SIGNATURE, cache=True, fastmath=SIMD_MATH, error_model="numpy")
-def field_serial(x, y, z, alpha, beta, sources, eps2, box, ax, ay, az):
+def field_serial(x, y, z, alpha, beta, targets, sources, eps2, box, ax, ay, az):
     """``field`` on one core: for mid-sized systems, where waking the other threads for each
     evaluation costs more than it saves (and a busy machine can stall a parallel region)."""
-    for c in range(x.shape[0]):
+    for c in range(targets):
         _target(c, x, y, z, alpha, beta, sources, eps2, box, ax, ay, az)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _field(x, y, z, alpha, beta, sources, eps2, box, ax, ay, az):
-    if x.shape[0] >= THREADS_MIN:
-        field(x, y, z, alpha, beta, sources, eps2, box, ax, ay, az)
+def _field(work, m, sources, eps2, box):
+    """The field of the gathered particles: coordinates, alpha and beta in ``work``'s first
+    five blocks of m, results into the last three."""
+    x = work[0:m]
+    y = work[m:2 * m]
+    z = work[2 * m:3 * m]
+    alpha = work[3 * m:4 * m]
+    beta = work[4 * m:5 * m]
+    ax = work[5 * m:6 * m]
+    ay = work[6 * m:7 * m]
+    az = work[7 * m:8 * m]
+    if m >= THREADS_MIN:
+        field(x, y, z, alpha, beta, m, sources, eps2, box, ax, ay, az)
     else:
-        field_serial(x, y, z, alpha, beta, sources, eps2, box, ax, ay, az)
+        field_serial(x, y, z, alpha, beta, m, sources, eps2, box, ax, ay, az)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
 def _gather(pos, iwork, m, work):
+    """Copy the m chosen particles' coordinates into work's first three blocks of m."""
     dim = pos.shape[0]
     for c in range(m):
         i = iwork[c]
@@ -145,22 +160,21 @@ def gravity(pos, mass, active, test, n, G, eps2, box, acc, work, iwork):
         if active[i] and not test[i]:
             src += 1
     a = 0
-    b = src
+    m = src
     for i in range(n):
         if active[i]:
             if test[i]:
-                iwork[b] = i
-                b += 1
+                iwork[m] = i
+                m += 1
             else:
                 iwork[a] = i
                 a += 1
-    m = b  # active particles, sources first
+    # m active particles, the src sources first
     _gather(pos, iwork, m, work)
     for c in range(m):
         work[3 * m + c] = 1.0
         work[4 * m + c] = G * mass[iwork[c]]
-    _field(work[0:m], work[m:2 * m], work[2 * m:3 * m], work[3 * m:4 * m], work[4 * m:5 * m], src,
-          eps2, box, work[5 * m:6 * m], work[6 * m:7 * m], work[7 * m:8 * m])
+    _field(work, m, src, eps2, box)
     _scatter(acc, iwork, m, work)
 
 
@@ -177,6 +191,5 @@ def coulomb(pos, mass, charge, active, n, k_e, eps2, box, acc, work, iwork):
         i = iwork[c]
         work[3 * m + c] = -k_e * charge[i] / mass[i]
         work[4 * m + c] = charge[i]
-    _field(work[0:m], work[m:2 * m], work[2 * m:3 * m], work[3 * m:4 * m], work[4 * m:5 * m], m,
-          eps2, box, work[5 * m:6 * m], work[6 * m:7 * m], work[7 * m:8 * m])
+    _field(work, m, m, eps2, box)
     _scatter(acc, iwork, m, work)

@@ -8,6 +8,8 @@ from engine.forces import pairwise
 from .test_forces import accel
 
 N = pairwise.PARALLEL_MIN + 57
+#: one size on the single-core vectorised kernel, one on the multi-core one
+SIZES = [pairwise.PARALLEL_MIN + 57, pairwise.THREADS_MIN + 57]
 
 
 def numpy_field(pos, weights, eps2, targets, sources, box=0.0):
@@ -24,13 +26,14 @@ def numpy_field(pos, weights, eps2, targets, sources, box=0.0):
     return out
 
 
+@pytest.mark.parametrize("n", SIZES)
 @pytest.mark.parametrize("dim", [2, 3])
-def test_gravity_large_n_matches_a_direct_sum(dim):
+def test_gravity_large_n_matches_a_direct_sum(dim, n):
     rng = np.random.default_rng(dim)
     sim = Simulation(dim=dim)
-    sim.add_many(mass=rng.uniform(0.5, 2.0, N), pos=rng.normal(size=(N, dim)),
-                 test=rng.random(N) < 0.2)
-    for i in rng.choice(N, 15, replace=False):
+    sim.add_many(mass=rng.uniform(0.5, 2.0, n), pos=rng.normal(size=(n, dim)),
+                 test=rng.random(n) < 0.2)
+    for i in rng.choice(n, 15, replace=False):
         sim.deactivate(int(i))
     sim.add_force(forces.NBodyGravity(G=0.7, softening=0.01))
     a = accel(sim)
@@ -41,17 +44,40 @@ def test_gravity_large_n_matches_a_direct_sum(dim):
     np.testing.assert_array_equal(a[~sim.active], 0.0)
 
 
-def test_coulomb_large_n_matches_a_direct_sum_on_a_torus():
+@pytest.mark.parametrize("n", SIZES)
+def test_coulomb_large_n_matches_a_direct_sum_on_a_torus(n):
     rng = np.random.default_rng(7)
     sim = Simulation(dim=2)
-    sim.add_many(mass=rng.uniform(0.5, 2.0, N), pos=rng.uniform(-5, 5, size=(N, 2)),
-                 charge=rng.choice([-1.0, 0.0, 1.0], N))
+    sim.add_many(mass=rng.uniform(0.5, 2.0, n), pos=rng.uniform(-5, 5, size=(n, 2)),
+                 charge=rng.choice([-1.0, 0.0, 1.0], n))
     sim.add_force(forces.Coulomb(k=0.3, softening=0.05, box=10.0))
     a = accel(sim)
     charged = np.flatnonzero(sim.charge != 0)
     field = numpy_field(sim.pos, sim.charge, 0.0025, charged, charged, box=10.0)
     expected = -0.3 * (sim.charge[charged] / sim.mass[charged])[:, None] * field
     np.testing.assert_allclose(a[charged], expected, rtol=1e-11, atol=1e-12 * np.abs(expected).max())
+
+
+@pytest.mark.parametrize("kind", ["gravity", "coulomb"])
+def test_without_a_workspace_the_scalar_loop_gives_the_same_field(kind):
+    # Spacewar's compiled frame passes no workspace: the kernels must not touch it then
+    from engine.forces.dispatch import accelerations
+
+    rng = np.random.default_rng(11)
+    n = SIZES[1]
+    sim = Simulation(dim=3)
+    sim.add_many(mass=rng.uniform(0.5, 2.0, n), pos=rng.normal(size=(n, 3)),
+                 charge=rng.choice([-1.0, 1.0], n), test=rng.random(n) < 0.2)
+    term = forces.NBodyGravity(softening=0.01) if kind == "gravity" else forces.Coulomb(softening=0.01)
+    sim.add_force(term)
+    pos, vel, prm, m, model = sim._kernel_state()
+    vectorised = np.zeros((3, m))
+    accelerations(sim.t, pos, vel, *prm, m, *model, vectorised, *pairwise.workspace(m))
+    scalar = np.zeros((3, m))
+    accelerations(sim.t, pos, vel, *prm, m, *model, scalar, np.empty(0),
+                  np.empty(0, dtype=np.int64))
+    np.testing.assert_allclose(vectorised, scalar, rtol=1e-11, atol=1e-13 * np.abs(scalar).max())
+    assert np.abs(scalar).max() > 0.1
 
 
 def test_large_n_momentum_and_determinism():
