@@ -165,28 +165,22 @@ def advance(t, h, steps, pos, vel, mass, active, n, G, eps2, drifts, kicks):
     fresh = False
     done = 0
     bad = OK
+    careful = False  # after a failed block: re-run it one step at a time
     while done < steps:
-        count = min(BLOCK, steps - done)
+        count = 1 if careful else min(BLOCK, steps - done)
         _copy(P, V, A, saved_P, saved_V, saved_A, m)
         saved_fresh = fresh
         fresh = _steps(P, V, A, gm, m, eps2, h, count, drifts, kicks, fresh)
         if _finite(P, V, m):
             done += count
             continue
-        # re-run the block one step at a time from its start, stopping before the bad step
+        row = _first_nonfinite_row(P, V, m)
         _copy(saved_P, saved_V, saved_A, P, V, A, m)
         fresh = saved_fresh
-        for _ in range(count):
-            _copy(P, V, A, saved_P, saved_V, saved_A, m)
-            saved_fresh = fresh
-            fresh = _steps(P, V, A, gm, m, eps2, h, 1, drifts, kicks, fresh)
-            row = _first_nonfinite_row(P, V, m)
-            if row >= 0:
-                _copy(saved_P, saved_V, saved_A, P, V, A, m)
-                bad = index[row]
-                break
-            done += 1
-        break
+        if careful:
+            bad = index[row]
+            break
+        careful = True
     for c in range(m):
         for k in range(dim):
             pos[k, index[c]] = P[c, k]
