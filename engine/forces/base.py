@@ -45,6 +45,12 @@ class Force:
         """Mark parameters changed so the next step re-reads them (no stale forces)."""
         self._version += 1
 
+    def __setattr__(self, name, value):
+        # assigning a public parameter (drag.linear = 0.5) must act from the next step on
+        object.__setattr__(self, name, value)
+        if not name.startswith("_") and "_version" in self.__dict__:
+            self._version += 1
+
     def __repr__(self):
         return f"{type(self).__name__}()"
 

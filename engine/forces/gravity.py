@@ -69,7 +69,8 @@ def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, i
     eps2 = fp[f0 + 1]
     box = fp[f0 + 2]
     if pairwise.usable(n, work):
-        pairwise.gravity(pos, mass, active, test, n, G, eps2, box, acc, work, iwork)
+        single = fp[f0 + 3] != 0.0
+        pairwise.gravity(pos, mass, active, test, n, G, eps2, box, single, acc, work, iwork)
         return
     three = pos.shape[0] == 3
     if box == 0.0 and three and _all_massive_and_active(active, test, n):
@@ -135,20 +136,32 @@ class NBodyGravity(Force):
     ``G=None`` uses the simulation's ``G`` (1.0 without units). ``softening`` is the Plummer
     length eps >= 0; with eps = 0 two coincident bodies make the step raise SimulationError.
     ``box``: side of a periodic (torus) domain; pairs then interact through their nearest image.
+    ``precision="float32"``: the vectorised kernel (from ``pairwise.PARALLEL_MIN`` bodies on)
+    sums the pairs in single precision, coordinates taken relative to the bodies' mean
+    position: about 2.5 times faster, with forces good to about 1e-6 of their size. Positions,
+    velocities, the small-N loop and the potential energy stay in float64 (the default).
     """
 
     KIND = KIND
     conservative = True
 
-    def __init__(self, G=None, softening=0.0, box=None):
+    PRECISIONS = ("float64", "float32")
+
+    def __init__(self, G=None, softening=0.0, box=None, precision="float64"):
         super().__init__()
+        if precision not in self.PRECISIONS:
+            raise ValueError(f"precision must be one of {', '.join(self.PRECISIONS)}; "
+                             f"got {precision!r}")
         self.G = None if G is None else nonnegative_float("G", G)
         self.softening = nonnegative_float("softening", softening)
         self.box = None if box is None else positive_float("box", box)
+        self.precision = precision
 
     def _pack(self, sim):
         G = sim.G if self.G is None else self.G
-        return floats(G, self.softening ** 2, self.box or 0.0), EMPTY_INTS
+        single = 1.0 if self.precision == "float32" else 0.0
+        return floats(G, self.softening ** 2, self.box or 0.0, single), EMPTY_INTS
 
     def __repr__(self):
-        return f"NBodyGravity(G={self.G!r}, softening={self.softening!r})"
+        return (f"NBodyGravity(G={self.G!r}, softening={self.softening!r}, box={self.box!r}, "
+                f"precision={self.precision!r})")

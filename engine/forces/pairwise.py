@@ -52,35 +52,36 @@ def usable(n, work):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _image(d, box):
+def _image(d, box, half):
+    """d shifted by whole boxes into [-box/2, box/2] (np.floor keeps d's precision)."""
     if box > 0.0:
-        return d - box * math.floor(d / box + 0.5)
+        return d - box * np.floor(d / box + half)
     return d
 
 
 @njit(cache=True, fastmath=SIMD_MATH, error_model="numpy", inline="always")
-def _target(c, x, y, z, alpha, beta, sources, eps2, box, ax, ay, az):
+def _target(c, x, y, z, alpha, beta, sources, eps2, box, zero, half, ax, ay, az):
     """a_c = alpha_c sum_{j < sources, j != c} beta_j d / r^3, in one branch-free pass over
     the sources that reads only, so it vectorises.
 
     Particle c is dropped as its own source by a select on the index (a vector compare and
-    blend), not by splitting the range in two: two shorter loops each end in a scalar
-    remainder of up to 31 pairs (8 lanes, 4 interleaved), which measured 2 to 3 times slower
+    blend), not by splitting the row into two loops around it, which measured 3 times slower
     at N = 1024. A genuinely coincident pair j != c still gives 0 * inf = NaN and is caught.
+    ``zero`` and ``half`` come in the arrays' precision, so a float32 call stays in float32.
     """
     xi = x[c]
     yi = y[c]
     zi = z[c]
-    sx = 0.0
-    sy = 0.0
-    sz = 0.0
+    sx = zero
+    sy = zero
+    sz = zero
     for j in range(sources):
-        dx = _image(x[j] - xi, box)
-        dy = _image(y[j] - yi, box)
-        dz = _image(z[j] - zi, box)
+        dx = _image(x[j] - xi, box, half)
+        dy = _image(y[j] - yi, box, half)
+        dz = _image(z[j] - zi, box, half)
         r2 = dx * dx + dy * dy + dz * dz + eps2
         bj = beta[j] / (r2 * math.sqrt(r2))
-        bj = 0.0 if j == c else bj
+        bj = zero if j == c else bj
         sx += bj * dx
         sy += bj * dy
         sz += bj * dz
@@ -91,39 +92,55 @@ def _target(c, x, y, z, alpha, beta, sources, eps2, box, ax, ay, az):
 
 # One explicit signature each: a parallel function is compiled into a kernel whose symbol every
 # cached caller links against; two specialisations of it (C and A layouts) in one cache were
-# seen to let a caller pick the wrong kernel and crash. So there is exactly one.
-_ARR = "float64[::1]"
-_FIELD_SIGNATURE = f"void({', '.join([_ARR] * 5)}, int64, int64, float64, float64, {', '.join([_ARR] * 3)})"
+# seen to let a caller pick the wrong kernel and crash. So there is exactly one per precision.
+def _signature(real):
+    arr = f"{real}[::1]"
+    return f"void({', '.join([arr] * 5)}, int64, int64, {real}, {real}, {', '.join([arr] * 3)})"
 
 
-@njit(_FIELD_SIGNATURE, parallel=True, cache=True, fastmath=SIMD_MATH, error_model="numpy")
+@njit(_signature("float64"), parallel=True, cache=True, fastmath=SIMD_MATH, error_model="numpy")
 def field(x, y, z, alpha, beta, targets, sources, eps2, box, ax, ay, az):
     """The field on particles [0, targets) from particles [0, sources), targets spread over
     all cores. Particles from ``sources`` on only feel the field (test particles)."""
     for c in prange(targets):
-        _target(c, x, y, z, alpha, beta, sources, eps2, box, ax, ay, az)
+        _target(c, x, y, z, alpha, beta, sources, eps2, box, 0.0, 0.5, ax, ay, az)
 
 
-@njit(_FIELD_SIGNATURE, cache=True, fastmath=SIMD_MATH, error_model="numpy")
+@njit(_signature("float64"), cache=True, fastmath=SIMD_MATH, error_model="numpy")
 def field_serial(x, y, z, alpha, beta, targets, sources, eps2, box, ax, ay, az):
     """``field`` on one core: for mid-sized systems, where waking the other threads for each
     evaluation costs more than it saves (and a busy machine can stall a parallel region)."""
     for c in range(targets):
-        _target(c, x, y, z, alpha, beta, sources, eps2, box, ax, ay, az)
+        _target(c, x, y, z, alpha, beta, sources, eps2, box, 0.0, 0.5, ax, ay, az)
+
+
+@njit(_signature("float32"), parallel=True, cache=True, fastmath=SIMD_MATH, error_model="numpy")
+def field32(x, y, z, alpha, beta, targets, sources, eps2, box, ax, ay, az):
+    """``field`` in single precision: 16 lanes per AVX-512 instruction instead of 8."""
+    for c in prange(targets):
+        _target(c, x, y, z, alpha, beta, sources, eps2, box, np.float32(0.0), np.float32(0.5),
+                ax, ay, az)
+
+
+@njit(_signature("float32"), cache=True, fastmath=SIMD_MATH, error_model="numpy")
+def field32_serial(x, y, z, alpha, beta, targets, sources, eps2, box, ax, ay, az):
+    """``field32`` on one core."""
+    for c in range(targets):
+        _target(c, x, y, z, alpha, beta, sources, eps2, box, np.float32(0.0), np.float32(0.5),
+                ax, ay, az)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _blocks(work, m):
+    """The eight blocks of m in ``work``: x, y, z, alpha, beta (inputs), ax, ay, az (results)."""
+    return (work[0:m], work[m:2 * m], work[2 * m:3 * m], work[3 * m:4 * m], work[4 * m:5 * m],
+            work[5 * m:6 * m], work[6 * m:7 * m], work[7 * m:8 * m])
 
 
 @njit(cache=True, error_model="numpy", inline="always")
 def _field(work, m, sources, eps2, box):
-    """The field of the gathered particles: coordinates, alpha and beta in ``work``'s first
-    five blocks of m, results into the last three."""
-    x = work[0:m]
-    y = work[m:2 * m]
-    z = work[2 * m:3 * m]
-    alpha = work[3 * m:4 * m]
-    beta = work[4 * m:5 * m]
-    ax = work[5 * m:6 * m]
-    ay = work[6 * m:7 * m]
-    az = work[7 * m:8 * m]
+    """The field of the m gathered particles in float64 ``work``."""
+    x, y, z, alpha, beta, ax, ay, az = _blocks(work, m)
     if m >= THREADS_MIN:
         field(x, y, z, alpha, beta, m, sources, eps2, box, ax, ay, az)
     else:
@@ -131,14 +148,44 @@ def _field(work, m, sources, eps2, box):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _gather(pos, iwork, m, work):
-    """Copy the m chosen particles' coordinates into work's first three blocks of m."""
+def _field32(work, m, sources, eps2, box):
+    """The field of the m gathered particles in float32 ``work``."""
+    x, y, z, alpha, beta, ax, ay, az = _blocks(work, m)
+    e = np.float32(eps2)
+    b = np.float32(box)
+    if m >= THREADS_MIN:
+        field32(x, y, z, alpha, beta, m, sources, e, b, ax, ay, az)
+    else:
+        field32_serial(x, y, z, alpha, beta, m, sources, e, b, ax, ay, az)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _centre(pos, iwork, m):
+    """Mean position of the m chosen particles (float32 coordinates are taken relative to it,
+    so a cluster far from the origin keeps its single-precision resolution)."""
+    dim = pos.shape[0]
+    cx = 0.0
+    cy = 0.0
+    cz = 0.0
+    for c in range(m):
+        i = iwork[c]
+        cx += pos[0, i]
+        cy += pos[1, i]
+        if dim == 3:
+            cz += pos[2, i]
+    return cx / m, cy / m, cz / m
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _gather(pos, iwork, m, work, cx, cy, cz):
+    """Copy the m chosen particles' coordinates, less (cx, cy, cz), into work's first three
+    blocks of m (converted to work's precision)."""
     dim = pos.shape[0]
     for c in range(m):
         i = iwork[c]
-        work[c] = pos[0, i]
-        work[m + c] = pos[1, i]
-        work[2 * m + c] = pos[2, i] if dim == 3 else 0.0
+        work[c] = pos[0, i] - cx
+        work[m + c] = pos[1, i] - cy
+        work[2 * m + c] = pos[2, i] - cz if dim == 3 else 0.0
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -152,9 +199,19 @@ def _scatter(acc, iwork, m, work):
             acc[2, i] += work[7 * m + c]
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def _gravity_inputs(pos, mass, iwork, m, G, work, cx, cy, cz):
+    """Coordinates (less the centre), alpha = 1 and beta = G m into ``work``."""
+    _gather(pos, iwork, m, work, cx, cy, cz)
+    for c in range(m):
+        work[3 * m + c] = 1.0
+        work[4 * m + c] = G * mass[iwork[c]]
+
+
 @njit(cache=True, error_model="numpy")
-def gravity(pos, mass, active, test, n, G, eps2, box, acc, work, iwork):
-    """acc += gravity of the active non-test particles on every active particle (large N)."""
+def gravity(pos, mass, active, test, n, G, eps2, box, single, acc, work, iwork):
+    """acc += gravity of the active non-test particles on every active particle (large N);
+    ``single``: pair sums in float32 (the workspace's memory seen as float32)."""
     src = 0
     for i in range(n):
         if active[i] and not test[i]:
@@ -170,12 +227,18 @@ def gravity(pos, mass, active, test, n, G, eps2, box, acc, work, iwork):
                 iwork[a] = i
                 a += 1
     # m active particles, the src sources first
-    _gather(pos, iwork, m, work)
-    for c in range(m):
-        work[3 * m + c] = 1.0
-        work[4 * m + c] = G * mass[iwork[c]]
-    _field(work, m, src, eps2, box)
-    _scatter(acc, iwork, m, work)
+    if m == 0:
+        return
+    if single:
+        cx, cy, cz = _centre(pos, iwork, m)
+        w32 = work.view(np.float32)
+        _gravity_inputs(pos, mass, iwork, m, G, w32, cx, cy, cz)
+        _field32(w32, m, src, eps2, box)
+        _scatter(acc, iwork, m, w32)
+    else:
+        _gravity_inputs(pos, mass, iwork, m, G, work, 0.0, 0.0, 0.0)
+        _field(work, m, src, eps2, box)
+        _scatter(acc, iwork, m, work)
 
 
 @njit(cache=True, error_model="numpy")
@@ -186,7 +249,7 @@ def coulomb(pos, mass, charge, active, n, k_e, eps2, box, acc, work, iwork):
         if active[i] and charge[i] != 0.0:
             iwork[m] = i
             m += 1
-    _gather(pos, iwork, m, work)
+    _gather(pos, iwork, m, work, 0.0, 0.0, 0.0)
     for c in range(m):
         i = iwork[c]
         work[3 * m + c] = -k_e * charge[i] / mass[i]

@@ -323,3 +323,20 @@ def test_gravity_open_space_fast_path_equals_the_general_loop():
     np.testing.assert_allclose(accel(fast), accel(general), rtol=1e-14)
     general.add(mass=0.0, pos=(5.0, 0.0, 0.0), test=True)  # a test particle: general path too
     np.testing.assert_allclose(accel(general)[:7], accel(fast), rtol=1e-14)
+
+
+@pytest.mark.parametrize("make, change", [
+    (lambda: forces.Drag(linear=0.1), lambda f: setattr(f, "linear", 2.0)),
+    (lambda: forces.NBodyGravity(softening=0.01), lambda f: setattr(f, "softening", 0.5)),
+    (lambda: forces.Coulomb(k=1.0), lambda f: setattr(f, "k", -3.0)),
+])
+def test_assigning_a_parameter_acts_from_the_next_step(make, change):
+    def run(changed):
+        sim = _random_sim(3, seed=9, n=6)
+        term = sim.add_force(make())
+        sim.step(5)
+        if changed:
+            change(term)
+        sim.step(5)
+        return sim.pos.copy()
+    assert not np.array_equal(run(True), run(False))

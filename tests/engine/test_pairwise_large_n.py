@@ -109,3 +109,29 @@ def test_large_n_coincident_bodies_still_fail_loudly():
         sim.step(3)
     assert info.value.particle in (10, 20)
     np.testing.assert_array_equal(sim.pos, before)
+
+
+@pytest.mark.parametrize("n", SIZES)
+@pytest.mark.parametrize("box", [None, 30.0])
+def test_float32_gravity_is_the_float64_field_to_single_precision(n, box):
+    rng = np.random.default_rng(n)
+    # a cluster far from the origin: float32 coordinates are taken relative to its centre
+    pos = rng.normal(size=(n, 3)) + 1e4 * (box is None)
+    fields = {}
+    for precision in ("float64", "float32"):
+        sim = Simulation(dim=3)
+        sim.add_many(mass=rng.uniform(0.5, 2.0, n) if not fields else masses, pos=pos,
+                     test=np.arange(n) % 7 == 3)
+        masses = sim.mass.copy()
+        sim.add_force(forces.NBodyGravity(softening=0.01, box=box, precision=precision))
+        fields[precision] = accel(sim)
+    exact, single = fields["float64"], fields["float32"]
+    scale = np.linalg.norm(exact, axis=1)
+    err = np.linalg.norm(single - exact, axis=1) / scale
+    assert err.max() < 1e-4 and np.median(err) < 1e-5
+    assert err.max() > 1e-12  # it really is a different computation
+
+
+def test_precision_is_checked():
+    with pytest.raises(ValueError, match="precision.*'float16'"):
+        forces.NBodyGravity(precision="float16")
