@@ -29,3 +29,20 @@ def test_report_sections_and_markdown():
     assert report["spacewar"]["batch"]["match_frames_per_second"] > 0
     assert set(report["terms"]["seconds_per_step"]) == {
         "1: gravity", "2: + drag", "4: + uniform gravity, Coulomb"}
+
+
+def test_targets_are_judged_from_the_figures():
+    report = {
+        "direct_sum": {"rows": [{"n": 256, "speedup_vs_rebound": 5.0},
+                                {"n": 1024, "speedup_vs_rebound": 7.9}]},
+        "small_n": {"engine_time_over_plain_loop": 1.29, "speedup_vs_rebound": 2.5},
+        "scaling": {"direct_slope_large_n": 2.6, "test_particle_slope_large_n": 1.0},
+        "terms": {"relative_to_gravity_alone": {"a": 1.0, "b": 1.2, "c": 2.0}},
+    }
+    verdicts = [met for _, _, met in bench.targets(report)]
+    assert verdicts == [False, True, True, False, True]
+    report["direct_sum"]["rows"][1]["speedup_vs_rebound"] = 8.1
+    report["terms"]["relative_to_gravity_alone"]["c"] = 0.5
+    verdicts = [met for _, _, met in bench.targets(report)]
+    assert verdicts == [True, True, True, False, False]
+    assert "8.1x (5.0x at 256)" == bench.targets(report)[0][1]
