@@ -432,7 +432,19 @@ HOW_THE_TARGETS_ARE_MET = """How, as measured while writing the kernels (micro-b
   checked once per 64 steps (a failed block is re-run step by step to stop at the last finite
   state). It is bit-identical to the general executor, which costs about 130 ns per step here:
   of that, the force-table call with its fifteen array arguments, the strided (dim, n) indexing
-  and the per-step save and check are about 70 ns."""
+  and the per-step save and check are about 70 ns.
+- **Single precision, optional.** `NBodyGravity(precision="float32")` runs the same kernel on
+  float32 copies of the coordinates, taken relative to the bodies' mean position (16 lanes per
+  instruction): the step is about 2x faster than float64 from N = 1024 on. Force error against
+  float64 for a cluster centred 1e4 from the origin: median 7e-8 to 9e-8, largest 1e-6 (N = 69,
+  249) and 1.2e-5 (N = 1024). State, small-N loop and energies stay float64.
+- **Start-up.** The first run after installing (or editing the engine) compiles every kernel:
+  about 14 s on this machine, of which 2.2 s are the four direct-sum kernels (float64 and
+  float32, one and all cores) and 1.5 s the fused executor. Later runs load the cache: 0.44 s.
+- **Not done.** A vectorised kernel that uses Newton's third law (each pair once) would halve
+  the large-N work again; numba gives no way to tell LLVM the reaction writes do not overlap
+  the reads, and the three formulations tried (scalar, split into vectorisable passes, one
+  interleaved array) were all slower than visiting each pair twice."""
 
 
 def targets(r):
