@@ -68,3 +68,19 @@ def per_item(name, value, count, *, minimum=None, strictly=False):
             raise ValueError(f"{name} must be {op} {minimum}, got {arr[bad][0]!r} "
                              f"(item {int(np.flatnonzero(bad)[0])})")
     return arr
+
+
+def optional(check):
+    """``check`` that lets None through (an optional parameter)."""
+    def validate(name, value):
+        return None if value is None else check(name, value)
+    return validate
+
+
+def one_of(*choices):
+    """A check that the value is one of ``choices``."""
+    def validate(name, value):
+        if not isinstance(value, str) or value not in choices:
+            raise ValueError(f"{name} must be one of {', '.join(choices)}; got {value!r}")
+        return value
+    return validate

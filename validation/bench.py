@@ -434,10 +434,12 @@ HOW_THE_TARGETS_ARE_MET = """How, as measured while writing the kernels (micro-b
   of that, the force-table call with its fifteen array arguments, the strided (dim, n) indexing
   and the per-step save and check are about 70 ns.
 - **Single precision, optional.** `NBodyGravity(precision="float32")` runs the same kernel on
-  float32 copies of the coordinates, taken relative to the bodies' mean position (16 lanes per
-  instruction): the step is about 2x faster than float64 from N = 1024 on. Force error against
-  float64 for a cluster centred 1e4 from the origin: median 7e-8 to 9e-8, largest 1e-6 (N = 69,
-  249) and 1.2e-5 (N = 1024). State, small-N loop and energies stay float64.
+  float32 copies of the coordinates, in a frame centred on the bodies' mean position and
+  scaled by a power of two to their extent (any units: SI distances would overflow r^3 in
+  float32 otherwise), 16 lanes per instruction: the step is about 2x faster than float64 from
+  N = 1024 on. Force error against float64 for a cluster centred 1e4 from the origin: median
+  7e-8 to 9e-8, largest 9e-7 (N = 69), 1.3e-6 (249) and 1.3e-5 (1024). State, small-N loop
+  and energies stay float64.
 - **Start-up.** The first run after installing (or editing the engine) compiles every kernel:
   about 14 s on this machine, of which 2.2 s are the four direct-sum kernels (float64 and
   float32, one and all cores) and 1.5 s the fused executor. Later runs load the cache: 0.44 s.

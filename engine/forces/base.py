@@ -7,15 +7,47 @@ returns its potential energy (0.0 when the term is not conservative). The term's
 parameters are ``fp[f0:f1]`` and its integer ones ``ip[i0:i1]``. The simulation concatenates all declared terms into
 one table so that a step calls one compiled function and pays only for the declared terms.
 """
+import functools
+
 import numpy as np
 
 
+def _sealing(init):
+    """Wrap a force's ``__init__`` so the instance is sealed once construction is over."""
+    @functools.wraps(init)
+    def __init__(self, *args, **kwargs):
+        depth = self.__dict__.get("_init_depth", 0)
+        object.__setattr__(self, "_init_depth", depth + 1)
+        try:
+            init(self, *args, **kwargs)
+        finally:
+            object.__setattr__(self, "_init_depth", depth)
+        if depth == 0:
+            object.__setattr__(self, "_sealed", True)
+    return __init__
+
+
 class Force:
-    """Base class of force terms. Subclasses set ``KIND`` and implement ``_pack``."""
+    """Base class of force terms. Subclasses set ``KIND`` and implement ``_pack``.
+
+    Parameters named in ``_settable`` (name -> check(name, value)) may be assigned at any time
+    (``drag.linear = 0.5``): the value is checked, the term re-checked against its simulation,
+    and the next step uses it. Other public attributes are fixed once the term is made:
+    assigning one raises AttributeError (an unchecked index array must never reach compiled
+    code, and a silently ignored assignment would be worse). Properties with setters
+    (``point_mass.pos = ...``) work as they define.
+    """
 
     KIND = -1
     #: True if the term has a potential that ``sim.potential_energy()`` sums.
     conservative = False
+    #: parameter name -> check(name, value) returning the value to store
+    _settable = {}
+
+    def __init_subclass__(cls, **kwargs):
+        super().__init_subclass__(**kwargs)
+        if "__init__" in cls.__dict__:
+            cls.__init__ = _sealing(cls.__dict__["__init__"])
 
     def __init__(self):
         self._version = 0
@@ -46,10 +78,29 @@ class Force:
         self._version += 1
 
     def __setattr__(self, name, value):
-        # assigning a public parameter (drag.linear = 0.5) must act from the next step on
+        if name.startswith("_") or isinstance(getattr(type(self), name, None), property):
+            object.__setattr__(self, name, value)
+            return
+        check = self._settable.get(name)
+        if check is None:
+            if self.__dict__.get("_sealed", False):
+                raise AttributeError(
+                    f"{type(self).__name__}.{name} cannot be changed once the term is made; "
+                    f"remove it (sim.remove_force) and add a new {type(self).__name__}")
+            object.__setattr__(self, name, value)
+            return
+        value = check(name, value)
+        old = self.__dict__.get(name)
         object.__setattr__(self, name, value)
-        if not name.startswith("_") and "_version" in self.__dict__:
-            self._version += 1
+        sim = self.__dict__.get("_sim")
+        if sim is not None:
+            try:
+                self._check(sim)
+            except Exception:
+                object.__setattr__(self, name, old)
+                raise
+        # the next step re-packs the parameters
+        object.__setattr__(self, "_version", self.__dict__.get("_version", 0) + 1)
 
     def __repr__(self):
         return f"{type(self).__name__}()"

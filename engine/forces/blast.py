@@ -46,22 +46,28 @@ def potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip
     return 0.0
 
 
+def _duration(name, value):
+    if isinstance(value, bool) or not (isinstance(value, (int, float, np.floating))
+                                       and value > 0 and not math.isnan(value)):
+        raise ValueError(f"{name} must be > 0 (inf allowed), got {value!r}")
+    return float(value)
+
+
 class Blast(Force):
     """Outward push of ``strength`` from ``center`` with length ``scale``, from ``start`` for
     ``duration`` (simulation time; ``duration=inf`` keeps it on)."""
 
     KIND = KIND
+    _settable = {"center": vector, "strength": finite_float, "scale": positive_float,
+                 "start": finite_float, "duration": _duration}
 
     def __init__(self, center, strength, scale=1.0, start=0.0, duration=math.inf):
         super().__init__()
-        self.center = vector("center", center)
-        self.strength = finite_float("strength", strength)
-        self.scale = positive_float("scale", scale)
-        self.start = finite_float("start", start)
-        if isinstance(duration, bool) or not (isinstance(duration, (int, float, np.floating))
-                                              and duration > 0 and not math.isnan(duration)):
-            raise ValueError(f"duration must be > 0 (inf allowed), got {duration!r}")
-        self.duration = float(duration)
+        self.center = center
+        self.strength = strength
+        self.scale = scale
+        self.start = start
+        self.duration = duration
 
     def _check(self, sim):
         if self.center.shape[0] != sim.dim:

@@ -85,20 +85,26 @@ def potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip
     return u
 
 
+def _axis(name, value):
+    if isinstance(value, bool) or value not in (0, 1, 2):
+        raise ValueError(f"{name} must be the axis index 0, 1 or 2, got {value!r}")
+    return int(value)
+
+
 class Buoyancy(Force):
     """Fluid of ``density`` filling everything below ``level`` along axis ``up`` (default y)."""
 
     KIND = KIND
     conservative = True
+    _settable = {"level": finite_float, "density": nonnegative_float, "g": positive_float,
+                 "up": _axis}
 
     def __init__(self, level=0.0, density=1000.0, g=9.8, up=1):
         super().__init__()
-        self.level = finite_float("level", level)
-        self.density = nonnegative_float("density", density)
-        self.g = positive_float("g", g)
-        if isinstance(up, bool) or up not in (0, 1, 2):
-            raise ValueError(f"up must be the axis index 0, 1 or 2, got {up!r}")
-        self.up = int(up)
+        self.level = level
+        self.density = density
+        self.g = g
+        self.up = up
 
     def _check(self, sim):
         if self.up >= sim.dim:

@@ -14,7 +14,7 @@ from numba import njit
 from . import pairwise
 from ._kernels import add_force, delta_periodic
 from .base import Force, floats, EMPTY_INTS
-from .._validate import nonnegative_float, finite_float, positive_float
+from .._validate import nonnegative_float, finite_float, optional, positive_float
 
 KIND = 3
 
@@ -26,7 +26,7 @@ def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, i
     eps2 = fp[f0 + 1]
     box = fp[f0 + 2]
     dim = pos.shape[0]
-    if pairwise.usable(n, work):
+    if pairwise.usable(n, work, iwork):
         pairwise.coulomb(pos, mass, charge, active, n, k, eps2, box, acc, work, iwork)
         return
     for i in range(n):
@@ -69,12 +69,14 @@ class Coulomb(Force):
 
     KIND = KIND
     conservative = True
+    _settable = {"k": finite_float, "softening": nonnegative_float,
+                 "box": optional(positive_float)}
 
     def __init__(self, k=1.0, softening=0.0, box=None):
         super().__init__()
-        self.k = finite_float("k", k)
-        self.softening = nonnegative_float("softening", softening)
-        self.box = None if box is None else positive_float("box", box)
+        self.k = k
+        self.softening = softening
+        self.box = box
 
     def _pack(self, sim):
         return floats(self.k, self.softening ** 2, self.box or 0.0), EMPTY_INTS

@@ -39,11 +39,12 @@ class Drag(Force):
     """Drag force ``-linear * v - quadratic * |v| v`` on every active particle."""
 
     KIND = KIND
+    _settable = {"linear": nonnegative_float, "quadratic": nonnegative_float}
 
     def __init__(self, linear=0.0, quadratic=0.0):
         super().__init__()
-        self.linear = nonnegative_float("linear", linear)
-        self.quadratic = nonnegative_float("quadratic", quadratic)
+        self.linear = linear
+        self.quadratic = quadratic
 
     @property
     def velocity_dependent(self):

@@ -18,7 +18,7 @@ from numba import njit
 from . import pairwise
 from ._kernels import delta_periodic, nearest_image
 from .base import Force, floats, EMPTY_INTS
-from .._validate import nonnegative_float, positive_float
+from .._validate import nonnegative_float, one_of, optional, positive_float
 
 KIND = 0
 
@@ -68,7 +68,7 @@ def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, i
     G = fp[f0]
     eps2 = fp[f0 + 1]
     box = fp[f0 + 2]
-    if pairwise.usable(n, work):
+    if pairwise.usable(n, work, iwork):
         single = fp[f0 + 3] != 0.0
         pairwise.gravity(pos, mass, active, test, n, G, eps2, box, single, acc, work, iwork)
         return
@@ -137,24 +137,26 @@ class NBodyGravity(Force):
     length eps >= 0; with eps = 0 two coincident bodies make the step raise SimulationError.
     ``box``: side of a periodic (torus) domain; pairs then interact through their nearest image.
     ``precision="float32"``: the vectorised kernel (from ``pairwise.PARALLEL_MIN`` bodies on)
-    sums the pairs in single precision, coordinates taken relative to the bodies' mean
-    position: about 2.5 times faster, with forces good to about 1e-6 of their size. Positions,
-    velocities, the small-N loop and the potential energy stay in float64 (the default).
+    sums the pairs in single precision, in a frame centred on the bodies' mean position and
+    scaled by their extent (so any units work): about 2 times faster per step. Forces come out
+    good to about 1e-6 of their size for one compact system; separations under about 1e-7 of
+    the system's extent are not resolved (such bodies coincide, and without softening the step
+    raises SimulationError), and a scene of distant clumps loses accuracy in proportion.
+    Positions, velocities, the small-N loop and the potential energy stay in float64.
     """
 
     KIND = KIND
     conservative = True
 
     PRECISIONS = ("float64", "float32")
+    _settable = {"G": optional(nonnegative_float), "softening": nonnegative_float,
+                 "box": optional(positive_float), "precision": one_of(*PRECISIONS)}
 
     def __init__(self, G=None, softening=0.0, box=None, precision="float64"):
         super().__init__()
-        if precision not in self.PRECISIONS:
-            raise ValueError(f"precision must be one of {', '.join(self.PRECISIONS)}; "
-                             f"got {precision!r}")
-        self.G = None if G is None else nonnegative_float("G", G)
-        self.softening = nonnegative_float("softening", softening)
-        self.box = None if box is None else positive_float("box", box)
+        self.G = G
+        self.softening = softening
+        self.box = box
         self.precision = precision
 
     def _pack(self, sim):

@@ -25,6 +25,10 @@ from numba import njit, prange
 #: reassociation and contraction for vector reductions; never 'nnan'/'ninf' (NaN must survive)
 SIMD_MATH = {"reassoc", "contract", "nsz", "arcp"}
 
+#: single precision without 'arcp': with it LLVM turns beta / (r2 sqrt(r2)) into an estimate
+#: of rsqrt(r2^3), whose r2^3 overflows float32 from r = 2.6e6 (NaN forces); as fast without
+SIMD_MATH32 = {"reassoc", "contract", "nsz"}
+
 #: from this many particle slots on, the vectorised kernels replace the scalar pair loop
 #: (measured on leapfrog steps: 16 bodies 0.32 us vectorised against 0.57 us scalar at 15;
 #: 8 bodies 0.25 us against 0.21 us)
@@ -46,9 +50,9 @@ def workspace(n):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def usable(n, work):
+def usable(n, work, iwork):
     """Does this call take the vectorised path: enough particles, and a workspace for them?"""
-    return n >= PARALLEL_MIN and work.shape[0] >= 8 * n
+    return n >= PARALLEL_MIN and work.shape[0] >= 8 * n and iwork.shape[0] >= n
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -114,7 +118,7 @@ def field_serial(x, y, z, alpha, beta, targets, sources, eps2, box, ax, ay, az):
         _target(c, x, y, z, alpha, beta, sources, eps2, box, 0.0, 0.5, ax, ay, az)
 
 
-@njit(_signature("float32"), parallel=True, cache=True, fastmath=SIMD_MATH, error_model="numpy")
+@njit(_signature("float32"), parallel=True, cache=True, fastmath=SIMD_MATH32, error_model="numpy")
 def field32(x, y, z, alpha, beta, targets, sources, eps2, box, ax, ay, az):
     """``field`` in single precision: 16 lanes per AVX-512 instruction instead of 8."""
     for c in prange(targets):
@@ -122,7 +126,7 @@ def field32(x, y, z, alpha, beta, targets, sources, eps2, box, ax, ay, az):
                 ax, ay, az)
 
 
-@njit(_signature("float32"), cache=True, fastmath=SIMD_MATH, error_model="numpy")
+@njit(_signature("float32"), cache=True, fastmath=SIMD_MATH32, error_model="numpy")
 def field32_serial(x, y, z, alpha, beta, targets, sources, eps2, box, ax, ay, az):
     """``field32`` on one core."""
     for c in range(targets):
@@ -160,9 +164,19 @@ def _field32(work, m, sources, eps2, box):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _centre(pos, iwork, m):
-    """Mean position of the m chosen particles (float32 coordinates are taken relative to it,
-    so a cluster far from the origin keeps its single-precision resolution)."""
+def _power_of_two_above(x):
+    """The smallest power of two >= x (1.0 for x = 0): scaling by it is exact."""
+    if x == 0.0 or not math.isfinite(x):
+        return 1.0
+    mantissa, exponent = math.frexp(x)
+    return math.ldexp(1.0, exponent)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _frame(pos, iwork, m):
+    """Centre and length scale of the m chosen particles, for float32 coordinates: their mean
+    position, and a power of two at least their largest distance from it along an axis. The
+    kernel then sees coordinates in [-1, 1], far from float32's overflow and underflow."""
     dim = pos.shape[0]
     cx = 0.0
     cy = 0.0
@@ -173,39 +187,50 @@ def _centre(pos, iwork, m):
         cy += pos[1, i]
         if dim == 3:
             cz += pos[2, i]
-    return cx / m, cy / m, cz / m
+    cx /= m
+    cy /= m
+    cz /= m
+    extent = 0.0
+    for c in range(m):
+        i = iwork[c]
+        extent = max(extent, abs(pos[0, i] - cx), abs(pos[1, i] - cy))
+        if dim == 3:
+            extent = max(extent, abs(pos[2, i] - cz))
+    return cx, cy, cz, _power_of_two_above(extent)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _gather(pos, iwork, m, work, cx, cy, cz):
-    """Copy the m chosen particles' coordinates, less (cx, cy, cz), into work's first three
-    blocks of m (converted to work's precision)."""
+def _gather(pos, iwork, m, work, cx, cy, cz, length):
+    """Copy the m chosen particles' coordinates, as (p - centre) / length, into work's first
+    three blocks of m (converted to work's precision)."""
     dim = pos.shape[0]
     for c in range(m):
         i = iwork[c]
-        work[c] = pos[0, i] - cx
-        work[m + c] = pos[1, i] - cy
-        work[2 * m + c] = pos[2, i] - cz if dim == 3 else 0.0
+        work[c] = (pos[0, i] - cx) / length
+        work[m + c] = (pos[1, i] - cy) / length
+        work[2 * m + c] = (pos[2, i] - cz) / length if dim == 3 else 0.0
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _scatter(acc, iwork, m, work):
+def _scatter(acc, iwork, m, work, scale):
+    """acc += scale * the results in work's last three blocks (scale undoes the float32 frame;
+    1.0, exactly, in float64)."""
     dim = acc.shape[0]
     for c in range(m):
         i = iwork[c]
-        acc[0, i] += work[5 * m + c]
-        acc[1, i] += work[6 * m + c]
+        acc[0, i] += scale * work[5 * m + c]
+        acc[1, i] += scale * work[6 * m + c]
         if dim == 3:
-            acc[2, i] += work[7 * m + c]
+            acc[2, i] += scale * work[7 * m + c]
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _gravity_inputs(pos, mass, iwork, m, G, work, cx, cy, cz):
-    """Coordinates (less the centre), alpha = 1 and beta = G m into ``work``."""
-    _gather(pos, iwork, m, work, cx, cy, cz)
+def _gravity_inputs(pos, mass, iwork, m, G, work, cx, cy, cz, length, weight):
+    """Coordinates in the frame (centre, length), alpha = 1, beta = G m / weight into work."""
+    _gather(pos, iwork, m, work, cx, cy, cz, length)
     for c in range(m):
         work[3 * m + c] = 1.0
-        work[4 * m + c] = G * mass[iwork[c]]
+        work[4 * m + c] = G * mass[iwork[c]] / weight
 
 
 @njit(cache=True, error_model="numpy")
@@ -230,15 +255,21 @@ def gravity(pos, mass, active, test, n, G, eps2, box, single, acc, work, iwork):
     if m == 0:
         return
     if single:
-        cx, cy, cz = _centre(pos, iwork, m)
+        # a = (G m_max / L^2) sum (m_j / m_max) d' / r'^3 with d' = d / L: every float32
+        # quantity is of order one, whatever the units (SI distances overflow r^3 otherwise)
+        cx, cy, cz, length = _frame(pos, iwork, m)
+        gm_max = 0.0
+        for c in range(src):
+            gm_max = max(gm_max, G * mass[iwork[c]])
+        weight = _power_of_two_above(gm_max)
         w32 = work.view(np.float32)
-        _gravity_inputs(pos, mass, iwork, m, G, w32, cx, cy, cz)
-        _field32(w32, m, src, eps2, box)
-        _scatter(acc, iwork, m, w32)
+        _gravity_inputs(pos, mass, iwork, m, G, w32, cx, cy, cz, length, weight)
+        _field32(w32, m, src, eps2 / (length * length), box / length)
+        _scatter(acc, iwork, m, w32, weight / (length * length))
     else:
-        _gravity_inputs(pos, mass, iwork, m, G, work, 0.0, 0.0, 0.0)
+        _gravity_inputs(pos, mass, iwork, m, G, work, 0.0, 0.0, 0.0, 1.0, 1.0)
         _field(work, m, src, eps2, box)
-        _scatter(acc, iwork, m, work)
+        _scatter(acc, iwork, m, work, 1.0)
 
 
 @njit(cache=True, error_model="numpy")
@@ -249,10 +280,10 @@ def coulomb(pos, mass, charge, active, n, k_e, eps2, box, acc, work, iwork):
         if active[i] and charge[i] != 0.0:
             iwork[m] = i
             m += 1
-    _gather(pos, iwork, m, work, 0.0, 0.0, 0.0)
+    _gather(pos, iwork, m, work, 0.0, 0.0, 0.0, 1.0)
     for c in range(m):
         i = iwork[c]
         work[3 * m + c] = -k_e * charge[i] / mass[i]
         work[4 * m + c] = charge[i]
     _field(work, m, m, eps2, box)
-    _scatter(acc, iwork, m, work)
+    _scatter(acc, iwork, m, work, 1.0)

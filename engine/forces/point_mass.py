@@ -75,6 +75,7 @@ class PointMass(Force):
 
     KIND = KIND
     conservative = True
+    _settable = {"softening": nonnegative_float}
 
     def __init__(self, mu=1.0, pos=(0.0, 0.0), softening=0.0, particles=None):
         super().__init__()

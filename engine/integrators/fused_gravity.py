@@ -11,7 +11,9 @@ than on the physics. This executor runs the same drift/kick sequence on an inter
 It computes exactly what ``splitting.advance`` computes, operation for operation: the same
 pair loop (Newton's third law, a_i += G m_j d / r^3, a_j -= G m_i d / r^3), the same
 kicks ``v += (d_k h) a`` and drifts ``p += (c_k h) v``, the same reuse of the last evaluation
-(verlet, yoshida4), so the results are bit-identical (the tests hold it to that).
+(verlet, yoshida4), so the results are bit-identical (the tests hold it to that). The one
+difference: an inactive body is left untouched here, where the general path's masked drift
+adds 0 to it (which turns a coordinate of -0.0 into +0.0).
 
 A blow-up is found without a check per step: a non-finite coordinate never becomes finite
 again within a call (inf and NaN absorb every later add and multiply), so the state is checked

@@ -340,3 +340,25 @@ def test_assigning_a_parameter_acts_from_the_next_step(make, change):
         sim.step(5)
         return sim.pos.copy()
     assert not np.array_equal(run(True), run(False))
+
+
+def test_assignments_are_checked_before_anything_changes():
+    sim = _random_sim(3, seed=9, n=6)
+    gravity = sim.add_force(forces.NBodyGravity(softening=0.1))
+    blast = sim.add_force(forces.Blast(center=(0.0, 0.0, 0.0), strength=1.0))
+    springs = sim.add_force(forces.Springs([(0, 1)], k=2.0))
+    with pytest.raises(ValueError, match=r"softening must be >= 0, got -1\.0"):
+        gravity.softening = -1.0
+    with pytest.raises(ValueError, match="precision must be one of float64, float32; got 'single'"):
+        gravity.precision = "single"
+    with pytest.raises(ValueError, match="center must have length 3"):
+        blast.center = (1.0, 2.0)  # a 2-D vector in a 3-D simulation
+    with pytest.raises(AttributeError, match=r"Springs\.pairs cannot be changed"):
+        springs.pairs = [(0, 10 ** 9)]  # would index far outside the particle arrays
+    assert gravity.softening == 0.1 and gravity.precision == "float64"
+    np.testing.assert_array_equal(blast.center, 0.0)
+    np.testing.assert_array_equal(springs.pairs, [[0, 1]])
+    sim.step(3)  # the simulation still runs with the unchanged terms
+    gravity.box = None  # optional parameters take None
+    gravity.precision = "float32"
+    assert "precision='float32'" in repr(gravity)

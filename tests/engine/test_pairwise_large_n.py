@@ -135,3 +135,26 @@ def test_float32_gravity_is_the_float64_field_to_single_precision(n, box):
 def test_precision_is_checked():
     with pytest.raises(ValueError, match="precision.*'float16'"):
         forces.NBodyGravity(precision="float16")
+
+
+@pytest.mark.parametrize("scale", [1e-9, 1.0, 3.844e8, 1e20])
+def test_float32_gravity_holds_in_any_units(scale):
+    """A bound system measured in any length unit (1e-9: nanometres of a unit-mass toy; 3.8e8:
+    the Earth-Moon distance in metres; 1e20: a galaxy in metres): single precision forces stay
+    finite and close to float64 (r^3 of SI distances overflows float32 unless the kernel works
+    in a scaled frame)."""
+    rng = np.random.default_rng(5)
+    n = pairwise.PARALLEL_MIN + 20
+    pos = rng.normal(size=(n, 3)) * scale
+    pos[0] *= 50.0  # one outlier far from the rest
+    fields = {}
+    for precision in ("float64", "float32"):
+        sim = Simulation(dim=3, G=6.674e-11 * scale ** 3)  # keeps accelerations of order one
+        sim.add_many(mass=rng.uniform(0.5, 2.0, n) if not fields else masses, pos=pos)
+        masses = sim.mass.copy()
+        sim.add_force(forces.NBodyGravity(precision=precision))
+        fields[precision] = accel(sim)
+    exact, single = fields["float64"], fields["float32"]
+    assert np.isfinite(single).all()
+    err = np.linalg.norm(single - exact, axis=1) / np.linalg.norm(exact, axis=1)
+    assert err.max() < 1e-4 and np.median(err) < 1e-5
