@@ -440,9 +440,10 @@ HOW_THE_TARGETS_ARE_MET = """How, as measured while writing the kernels (micro-b
   N = 1024 on. Force error against float64 for a cluster centred 1e4 from the origin: median
   7e-8 to 9e-8, largest 9e-7 (N = 69), 1.3e-6 (249) and 1.3e-5 (1024). State, small-N loop
   and energies stay float64.
-- **Start-up.** The first run after installing (or editing the engine) compiles every kernel:
-  about 14 s on this machine, of which 2.2 s are the four direct-sum kernels (float64 and
-  float32, one and all cores) and 1.5 s the fused executor. Later runs load the cache: 0.44 s.
+- **Start-up.** The first run after installing (or editing the engine) compiles every kernel
+  (section 5), of which 2.2 s are the four direct-sum kernels (float64 and float32, one and
+  all cores) and 1.5 s the fused executor; it was 9 to 10 s before both existed. Later runs
+  load the compiled code from the cache.
 - **Not done.** A vectorised kernel that uses Newton's third law (each pair once) would halve
   the large-N work again; numba gives no way to tell LLVM the reaction writes do not overlap
   the reads, and the three formulations tried (scalar, split into vectorisable passes, one
