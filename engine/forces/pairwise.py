@@ -13,9 +13,13 @@ Why not Newton's third law here, as the small-N kernel does? Writing the reactio
 other body inside the loop stops the vectoriser (it cannot prove the arrays do not overlap):
 measured on this project's 2-core machine (one core, N = 1024), the vectorised full sum costs
 0.41 ns per pair visit against 4.5 ns per pair for the scalar symmetric loop, so it wins by
-5x even doing each pair twice. Each target's sum is independent of the others, so the result does not depend on
-the number of threads. The loops are compiled with the reassociation vector reductions need,
-never with 'nnan'/'ninf': a singular pair must still produce NaN and be caught.
+5x even doing each pair twice. Each target's sum is independent of the others, so the result
+does not depend on the number of threads. The loops are compiled with the reassociation vector
+reductions need, never with 'nnan'/'ninf': a singular pair must still produce NaN and be caught.
+
+Gravity can also run in single precision (``NBodyGravity(precision="float32")``): the same
+loop on float32 copies of the coordinates, in a frame centred on the particles and scaled to
+their extent by a power of two, so that no unit system overflows r^3.
 """
 import math
 
@@ -168,7 +172,7 @@ def _power_of_two_above(x):
     """The smallest power of two >= x (1.0 for x = 0): scaling by it is exact."""
     if x == 0.0 or not math.isfinite(x):
         return 1.0
-    mantissa, exponent = math.frexp(x)
+    _, exponent = math.frexp(x)
     return math.ldexp(1.0, exponent)
 
 
