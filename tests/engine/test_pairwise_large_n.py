@@ -117,12 +117,11 @@ def test_float32_gravity_is_the_float64_field_to_single_precision(n, box):
     rng = np.random.default_rng(n)
     # a cluster far from the origin: float32 coordinates are taken relative to its centre
     pos = rng.normal(size=(n, 3)) + 1e4 * (box is None)
+    masses = rng.uniform(0.5, 2.0, n)
     fields = {}
     for precision in ("float64", "float32"):
         sim = Simulation(dim=3)
-        sim.add_many(mass=rng.uniform(0.5, 2.0, n) if not fields else masses, pos=pos,
-                     test=np.arange(n) % 7 == 3)
-        masses = sim.mass.copy()
+        sim.add_many(mass=masses, pos=pos, test=np.arange(n) % 7 == 3)
         sim.add_force(forces.NBodyGravity(softening=0.01, box=box, precision=precision))
         fields[precision] = accel(sim)
     exact, single = fields["float64"], fields["float32"]
@@ -147,11 +146,11 @@ def test_float32_gravity_holds_in_any_units(scale):
     n = pairwise.PARALLEL_MIN + 20
     pos = rng.normal(size=(n, 3)) * scale
     pos[0] *= 50.0  # one outlier far from the rest
+    masses = rng.uniform(0.5, 2.0, n)
     fields = {}
     for precision in ("float64", "float32"):
         sim = Simulation(dim=3, G=6.674e-11 * scale ** 3)  # keeps accelerations of order one
-        sim.add_many(mass=rng.uniform(0.5, 2.0, n) if not fields else masses, pos=pos)
-        masses = sim.mass.copy()
+        sim.add_many(mass=masses, pos=pos)
         sim.add_force(forces.NBodyGravity(precision=precision))
         fields[precision] = accel(sim)
     exact, single = fields["float64"], fields["float32"]
