@@ -1,7 +1,10 @@
 """The ``spacewar`` command: bots, match, tournament, replay, play."""
 import argparse
 import json
+import math
 import sys
+
+from engine.atomic import check_output_path
 
 from .rules import MODES, STARS, Rules
 
@@ -25,38 +28,82 @@ def _add_rules_options(p):
 
 
 def _add_fault_options(p):
-    g = p.add_argument_group("bot fault isolation")
-    g.add_argument("--budget-ms", type=float, default=50.0,
-                   help="time budget per action in ms; a slower answer is dropped (default 50)")
-    g.add_argument("--max-faults", type=int, default=25,
-                   help="faults (exception, timeout, invalid action) that forfeit a match (default 25)")
-    g.add_argument("--isolation", choices=("auto", "inline", "process"), default="auto",
-                   help="run bots in this process (inline) or each in its own (process); auto: "
-                        "built-in bots inline, others in a process")
+    g = p.add_argument_group("bot budgets and fault isolation (see docs/game.md, "
+                             "'Running untrusted bots')")
+    g.add_argument("--budget-ms", type=_positive_float, default=50.0,
+                   help="time budget per action in ms; a slower answer is paid from the overage "
+                        "bank, then dropped")
+    g.add_argument("--overage-ms", type=_non_negative_float, default=1000.0,
+                   help="overage bank per match in ms, for answers over the budget")
+    g.add_argument("--startup-s", type=_positive_float, default=10.0,
+                   help="start-up budget in s for a bot's import, construction and reset")
+    g.add_argument("--bot-memory-mb", type=_positive_int, default=1024,
+                   help="address-space limit of an isolated bot's process in MiB")
+    g.add_argument("--max-faults", type=_positive_int, default=25,
+                   help="faults (exception, timeout, invalid action) that forfeit a match")
+    g.add_argument("--isolation", choices=("auto", "process"), default="auto",
+                   help="auto: built-in bots in this process, every other bot in its own "
+                        "confined process; process: built-in bots too")
+
+
+def _limits_from(args):
+    from .seats import Limits
+
+    return Limits(budget=args.budget_ms / 1000.0, overage=args.overage_ms / 1000.0,
+                  startup=args.startup_s, memory_mb=args.bot_memory_mb)
+
+
+def _finite(text):
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a number, got {text!r}") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"must be finite, got {text!r}")
+    return value
+
+
+def _positive_float(text):
+    value = _finite(text)
+    if value <= 0:
+        raise argparse.ArgumentTypeError(f"must be > 0, got {text!r}")
+    return value
+
+
+def _non_negative_float(text):
+    value = _finite(text)
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"must be >= 0, got {text!r}")
+    return value
+
+
+def _int(text, low, high):
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be an integer, got {text!r}") from None
+    if not low <= value <= high:
+        raise argparse.ArgumentTypeError(f"must be in [{low}, {high}], got {text}")
+    return value
 
 
 def _positive_int(text):
-    value = int(text)
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"must be >= 1, got {value}")
-    return value
+    return _int(text, 1, 1_000_000)
 
 
 def _seed(text):
-    value = int(text)
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"must be >= 0, got {value}")
-    return value
+    return _int(text, 0, 2**63 - 1)
 
 
 def build_parser():
     parser = argparse.ArgumentParser(
         prog="spacewar", description="Spacewar! (1962) on an N-body engine, for bots.")
     sub = parser.add_subparsers(dest="command", required=True)
+    fmt = {"formatter_class": argparse.ArgumentDefaultsHelpFormatter}
 
-    sub.add_parser("bots", help="list the built-in bots")
+    sub.add_parser("bots", **fmt, help="list the built-in bots")
 
-    m = sub.add_parser("match", help="play one match between two bots")
+    m = sub.add_parser("match", **fmt, help="play one match between two bots")
     m.add_argument("--p1", required=True, help="bot: a built-in name, package.module:Class or path/to/file.py:Class")
     m.add_argument("--p2", required=True, help="the other bot")
     m.add_argument("--seed", type=_seed, default=0)
@@ -66,7 +113,7 @@ def build_parser():
     _add_rules_options(m)
     _add_fault_options(m)
 
-    t = sub.add_parser("tournament", help="round robin between bots, both seat orders")
+    t = sub.add_parser("tournament", **fmt, help="round robin between bots, both seat orders")
     t.add_argument("--bots", required=True, help="comma-separated bots")
     t.add_argument("--games", type=_positive_int, default=10, help="seeds per pair, each played in both seat orders")
     t.add_argument("--seed", type=_seed, default=1)
@@ -77,7 +124,7 @@ def build_parser():
     _add_rules_options(t)
     _add_fault_options(t)
 
-    r = sub.add_parser("replay", help="check a replay or render it to a GIF")
+    r = sub.add_parser("replay", **fmt, help="check a replay or render it to a GIF")
     r.add_argument("file")
     what = r.add_mutually_exclusive_group(required=True)
     what.add_argument("--check", action="store_true", help="re-simulate and confirm the identical outcome")
@@ -85,7 +132,11 @@ def build_parser():
     r.add_argument("--every", type=_positive_int, default=2, help="draw every n-th frame (GIF)")
     r.add_argument("--size", type=_positive_int, default=480, help="GIF side in pixels")
 
-    p = sub.add_parser("play", help="you at the keyboard against a bot (needs the [viz] extra)")
+    b = sub.add_parser("sandbox", **fmt, help="show what confines an isolated bot on this machine, "
+                                              "by running a probe bot that tries each attack")
+    b.add_argument("--json", action="store_true", help="print the findings as JSON")
+
+    p = sub.add_parser("play", **fmt, help="you at the keyboard against a bot (needs the [viz] extra)")
     p.add_argument("--p2", default="chaser", help="the bot to play against")
     p.add_argument("--seed", type=_seed, default=0)
     p.add_argument("--rounds", type=_positive_int, default=5)
@@ -94,11 +145,16 @@ def build_parser():
     return parser
 
 
+FAULT_KINDS = ("raised", "invalid", "timeout", "crashed", "startup", "memory")
+
+
 def _describe_match(result, timing):
     p1, p2 = result["bots"]
     a, b = result["score"]
-    if result["forfeit"]:
-        head = f"{result['winner']} wins: {result['forfeit']} forfeited after repeated faults"
+    if all(result.get("forfeits", [False, False])):
+        head = f"no winner: both {p1} and {p2} forfeited"
+    elif result["forfeit"]:
+        head = f"{result['winner']} wins: {result['forfeit']} forfeited"
     elif result["winner"] is None:
         head = f"draw {a}-{b} between {p1} and {p2}"
     else:
@@ -110,7 +166,7 @@ def _describe_match(result, timing):
     for seat, name in enumerate((p1, p2)):
         f = result["faults"][seat]
         if f["total"]:
-            kinds = ", ".join(f"{k} {f[k]}" for k in ("raised", "invalid", "timeout", "crashed") if f[k])
+            kinds = ", ".join(f"{k} {f[k]}" for k in FAULT_KINDS if f.get(k))
             lines.append(f"  faults of {name} (seat {seat + 1}): {f['total']} ({kinds}); "
                          f"first: {f['examples'][0]['message']}")
     if timing is not None:
@@ -136,9 +192,11 @@ def _cmd_match(args):
     from .match import play_match
     from . import replay as replay_io
 
+    if args.replay:
+        check_output_path(args.replay, "replay")  # before the match, not after it
     result, rep, timing = play_match(
         args.p1, args.p2, seed=args.seed, rounds=args.rounds, rules=_rules_from(args),
-        budget=args.budget_ms / 1000.0, max_faults=args.max_faults, isolation=args.isolation,
+        limits=_limits_from(args), max_faults=args.max_faults, isolation=args.isolation,
         record=bool(args.replay))
     if args.replay:
         replay_io.save(args.replay, rep)
@@ -158,7 +216,7 @@ def _cmd_tournament(args):
     report, stats = run_tournament(
         bots, games=args.games, seed=args.seed, rounds=args.rounds, rules=_rules_from(args),
         workers=args.workers, progress=not args.no_progress and not args.json,
-        budget=args.budget_ms / 1000.0, max_faults=args.max_faults, isolation=args.isolation)
+        limits=_limits_from(args), max_faults=args.max_faults, isolation=args.isolation)
     if args.json:
         print(json.dumps(report, sort_keys=True, indent=2))
     else:
@@ -186,9 +244,21 @@ def _cmd_replay(args):
         return 1
     from .render import render_gif
 
+    check_output_path(args.gif, "gif")
     render_gif(data, args.gif, every=args.every, size=args.size)
     print(f"wrote {args.gif}")
     return 0
+
+
+def _cmd_sandbox(args):
+    from .sandbox_probe import format_findings, probe
+
+    findings = probe()
+    if args.json:
+        print(json.dumps(findings, sort_keys=True, indent=2))
+    else:
+        print(format_findings(findings))
+    return 0 if findings["ok"] else 1
 
 
 def _cmd_play(args):
@@ -201,7 +271,7 @@ def _cmd_play(args):
 
 
 COMMANDS = {"bots": _cmd_bots, "match": _cmd_match, "tournament": _cmd_tournament,
-            "replay": _cmd_replay, "play": _cmd_play}
+            "replay": _cmd_replay, "play": _cmd_play, "sandbox": _cmd_sandbox}
 
 
 def main(argv=None):

@@ -37,8 +37,7 @@ HEADING, OMEGA, FUEL, SF = 0, 1, 2, 3
  R_ELECTRIC, R_THRUST_OFF, RN) = range(36)
 
 # action codes: turn index (0, 1, 2 for -1, 0, +1) + 3 thrust + 6 fire + 12 hyperspace + 24 flip
-N_ACTIONS = 48
-NOOP = 1
+from .codes import N_ACTIONS, NOOP  # noqa: E402  (kept here: core.NOOP is used throughout)
 
 _GOLDEN = np.uint64(0x9E3779B97F4A7C15)
 _MIX1 = np.uint64(0xBF58476D1CE4E5B9)

@@ -16,7 +16,7 @@ import numpy as np
 from engine import Simulation, forces
 from engine._cache import project_cache
 
-from .protocol import Action, Observation, Ship, Torpedo
+from .protocol import Action, observation_from_raw, raw_length
 from .rules import Rules
 
 with project_cache():
@@ -184,56 +184,44 @@ class Game:
     def errored(self, m=0):
         return bool(self.mi[m, core.ERROR])
 
-    def _ship(self, m, s):
-        f = self.ship_f[m, s]
-        i = self.ship_i[m, s]
-        return Ship(pos=self.pos[m, :, s].copy(), vel=self.vel[m, :, s].copy(),
-                    heading=float(f[core.HEADING]), angular_velocity=float(f[core.OMEGA]),
-                    fuel=float(f[core.FUEL]), torpedoes=int(i[core.TORPS]),
-                    hyperspace=int(i[core.HYPER_LEFT]), alive=bool(i[core.ALIVE]),
-                    in_hyperspace=bool(i[core.IN_HYPER]), reload=int(i[core.RELOAD]),
-                    hyperspace_recharge=int(i[core.HYPER_RECHARGE]),
-                    charge=float(self.charge[m, s]), flip_cooldown=int(i[core.FLIP_CD]))
-
-    def observe(self, m, seat):
-        """The observation of match ``m`` from seat ``seat``'s side."""
+    def raw_observation(self, m, seat, out=None):
+        """The observation of match ``m`` from seat ``seat`` as a flat float64 array
+        (``spacewar.protocol.raw_layout`` names its entries); written into ``out`` if given."""
         rules = self.rules
         t = rules.torpedoes
-        me, enemy = self._ship(m, seat), self._ship(m, 1 - seat)
-        torpedoes = []
-        vec_t = np.zeros((2 * t, 7))
+        raw = np.empty(raw_length(rules)) if out is None else out
+        mi = self.mi[m]
+        raw[:10] = (mi[core.FRAME], mi[core.ROUND_FRAME], mi[core.ROUNDS_PLAYED],
+                    mi[core.SCORE0 + seat], mi[core.SCORE0 + 1 - seat], seat,
+                    rules.effective_star_mu, rules.star_capture, 0.0, 0.0)
+        for row, s in enumerate((seat, 1 - seat)):
+            f = self.ship_f[m, s]
+            i = self.ship_i[m, s]
+            o = 10 + 15 * row
+            raw[o:o + 15] = (self.pos[m, 0, s], self.pos[m, 1, s], self.vel[m, 0, s],
+                             self.vel[m, 1, s], f[core.HEADING], f[core.OMEGA], f[core.FUEL],
+                             i[core.TORPS], i[core.HYPER_LEFT], i[core.ALIVE], i[core.IN_HYPER],
+                             i[core.RELOAD], i[core.HYPER_RECHARGE], self.charge[m, s],
+                             i[core.FLIP_CD])
+        o = 40
         for row, owner in enumerate((seat, 1 - seat)):
             for k in range(t):
                 b = 2 + owner * t + k
-                if not self.active[m, b]:
-                    continue
-                ttl = int(self.torp_life[m, owner * t + k])
-                p = self.pos[m, :, b].copy()
-                v = self.vel[m, :, b].copy()
-                torpedoes.append(Torpedo(pos=p, vel=v, mine=owner == seat, ttl=ttl,
-                                         charge=float(self.charge[m, b])))
-                vec_t[row * t + k] = (1.0, p[0], p[1], v[0], v[1], float(owner == seat),
-                                      ttl / max(rules.torpedo_life, 1))
-        mi = self.mi[m]
-        score = (int(mi[core.SCORE0 + seat]), int(mi[core.SCORE0 + 1 - seat]))
-        vector = np.concatenate((self._ship_vector(me), self._ship_vector(enemy),
-                                 [rules.effective_star_mu / max(rules.star_mu, 1e-300),
-                                  mi[core.ROUND_FRAME] / rules.max_round_frames],
-                                 vec_t.ravel()))
-        return Observation(me=me, enemy=enemy, torpedoes=tuple(torpedoes),
-                           star_pos=np.zeros(2), star_mu=rules.effective_star_mu,
-                           star_capture=rules.star_capture, frame=int(mi[core.FRAME]),
-                           round_frame=int(mi[core.ROUND_FRAME]),
-                           round=int(mi[core.ROUNDS_PLAYED]), score=score, seat=seat,
-                           rules=rules, _vector=vector)
+                if self.active[m, b]:
+                    raw[o:o + 8] = (1.0, self.pos[m, 0, b], self.pos[m, 1, b], self.vel[m, 0, b],
+                                    self.vel[m, 1, b], float(owner == seat),
+                                    self.torp_life[m, owner * t + k], self.charge[m, b])
+                else:
+                    raw[o:o + 8] = 0.0
+                o += 8
+        return raw
 
-    def _ship_vector(self, ship):
-        r = self.rules
-        return [ship.pos[0], ship.pos[1], ship.vel[0], ship.vel[1], np.cos(ship.heading),
-                np.sin(ship.heading), ship.angular_velocity, ship.fuel / max(r.fuel, 1e-300),
-                ship.torpedoes / r.torpedoes, ship.hyperspace / max(r.hyperspace_jumps, 1),
-                float(ship.alive), float(ship.in_hyperspace), ship.reload / max(r.reload, 1),
-                float(np.sign(ship.charge)), ship.flip_cooldown / max(r.flip_cooldown, 1)]
+    def observe(self, m, seat, rules=None):
+        """The observation of match ``m`` from seat ``seat``'s side: a fresh object whose arrays
+        are read-only, so a bot cannot change the game through it. ``rules`` is the object
+        put in ``obs.rules`` (default: the game's own, frozen, rules)."""
+        return observation_from_raw(self.raw_observation(m, seat),
+                                    self.rules if rules is None else rules)
 
     def snapshot(self, m=0):
         """Plain data for drawing match ``m``: ships, torpedoes, score, frame."""

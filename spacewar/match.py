@@ -1,12 +1,16 @@
 """A match between two bots: fault-isolated seats, optional replay, a deterministic result.
 
-    result = play_match("chaser", "sniper", seed=7, rounds=5)
+    result, replay, timing = play_match("chaser", "sniper", seed=7, rounds=5)
     result["winner"], result["score"]
 
 The result is plain data (JSON-ready) holding no wall-clock figure, so the same seed and
-bots give byte-identical JSON. A bot whose faults reach ``max_faults`` forfeits: the match
-stops and the other bot wins.
+bots give byte-identical JSON. A bot whose faults reach ``max_faults`` forfeits, and so does
+one that cannot start, dies, breaks the wire protocol or hangs: the match stops and the other
+bot wins. ``result["faults"]`` counts each kind of fault per seat with the first messages,
+``result["forfeits"]`` says which seats forfeited, ``result["output"]`` holds the first
+bytes each isolated bot wrote to its stdout and stderr (never this process's stdout).
 """
+import math
 import time
 
 import numpy as np
@@ -14,10 +18,11 @@ import numpy as np
 from . import core
 from .game import Game
 from .rules import Rules
-from .seats import FAULT_KINDS, open_seat
+from .seats import FAULT_KINDS, Limits, bot_name, open_seat
 
 DEFAULT_BUDGET = 0.05  # seconds per action
 DEFAULT_MAX_FAULTS = 25
+MAX_MESSAGE = 300  # characters of a fault message kept in the result
 
 
 def bot_seed(seed, seat):
@@ -35,7 +40,8 @@ class FaultLog:
     def add(self, frame, kind, message):
         self.counts[kind] += 1
         if len(self.examples) < 5:
-            self.examples.append({"frame": int(frame), "kind": kind, "message": message})
+            self.examples.append({"frame": int(frame), "kind": kind,
+                                  "message": str(message)[:MAX_MESSAGE]})
 
     @property
     def total(self):
@@ -46,63 +52,91 @@ class FaultLog:
 
 
 def play_match(p1, p2, seed=0, rounds=5, rules=None, budget=DEFAULT_BUDGET,
-               max_faults=DEFAULT_MAX_FAULTS, isolation="auto", record=False, on_frame=None):
-    """Play one match; return the result dict (and the replay dict if ``record``).
+               max_faults=DEFAULT_MAX_FAULTS, isolation="auto", record=False, on_frame=None,
+               limits=None):
+    """Play one match; return ``(result, replay, timing)``.
 
-    ``p1`` and ``p2`` are bot specifications (see ``spacewar.bots``). ``on_frame(game)`` is
-    called after every frame (for progress or drawing).
+    ``result`` is the plain-data result (see the module docstring), ``replay`` the replay
+    dict when ``record`` is true (else None), ``timing`` the wall-clock figures (kept out of
+    the result so that results are byte-identical). ``p1`` and ``p2`` are bot specifications
+    (see ``spacewar.bots``) or bot objects; built-in bots and bot objects play in this
+    process, every other bot in its own confined process (``spacewar.seats``). ``limits`` (a ``spacewar.seats.Limits``) sets every
+    budget; ``budget`` alone sets the per-action one. ``on_frame(game)`` is called after every
+    frame. A bot that cannot start, dies, breaks the protocol, hangs or reaches ``max_faults``
+    forfeits; the other bot wins (if both forfeit, nobody does).
     """
     rules = Rules() if rules is None else rules
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise ValueError(f"seed must be an int >= 0, got {seed!r}")
-    if budget <= 0:
-        raise ValueError(f"budget must be > 0 seconds, got {budget!r}")
     if isinstance(max_faults, bool) or not isinstance(max_faults, int) or max_faults < 1:
         raise ValueError(f"max_faults must be an int >= 1, got {max_faults!r}")
+    limits = Limits(budget=budget) if limits is None else limits
+    if not isinstance(limits, Limits):
+        raise TypeError(f"limits must be a spacewar.seats.Limits, got {limits!r}")
     game = Game(rules, seeds=[seed], rounds=rounds)
+    cpu = _cpu_seconds(rules, rounds, limits)
     seats = []
+    faults = [FaultLog(), FaultLog()]
+    forfeits = [False, False]
+    outputs = [None, None]
+    history = bytearray() if record else None
+    fault_codes = bytearray() if record else None
+    start = time.perf_counter()
     try:
         for s, spec in enumerate((p1, p2)):
-            seats.append(open_seat(spec, bot_seed(seed, s), budget, isolation))
-        faults = [FaultLog(), FaultLog()]
+            seats.append(open_seat(spec, bot_seed(seed, s), limits, rules, isolation, cpu))
+        for s, seat in enumerate(seats):
+            if hasattr(seat, "wait_ready") and seat.wait_ready() is not None:
+                faults[s].add(0, *seat.dead)
+                forfeits[s] = True
         actions = np.full((1, 2), core.NOOP, dtype=np.int64)
-        history = bytearray() if record else None
-        forfeit = None
-        start = time.perf_counter()
-        while not game.over[0]:
+        while not game.over[0] and not any(forfeits):
             frame = int(game.mi[0, core.FRAME])
+            kinds = [0, 0]
             for s, seat in enumerate(seats):
-                code, fault = seat.act(game.observe(0, s))
+                code, fault = seat.act(game.raw_observation(0, s))
                 actions[0, s] = code
                 if fault is not None:
                     faults[s].add(frame, *fault)
-            for s in range(2):
-                if faults[s].total >= max_faults and forfeit is None:
-                    forfeit = s
-            if forfeit is not None:
+                    kinds[s] = 1 + FAULT_KINDS.index(fault[0])
+                if seat.dead is not None or faults[s].total >= max_faults:
+                    forfeits[s] = True
+            if record:
+                fault_codes += bytes(kinds)
+            if any(forfeits):
                 break
             game.step(actions)
             if record:
                 history += bytes((int(actions[0, 0]), int(actions[0, 1])))
             if on_frame is not None:
                 on_frame(game)
-        wall = time.perf_counter() - start
     finally:
-        for seat in seats:
-            seat.close()
-    result = _result(game, (p1, p2), seed, rounds, rules, faults, forfeit)
+        for s, seat in enumerate(seats):
+            outputs[s] = seat.close()
+    wall = time.perf_counter() - start
+    result = _result(game, (bot_name(p1), bot_name(p2)), seed, rounds, rules, faults, forfeits, outputs)
     result_timing = {"wall_seconds": wall, "frames_per_second": result["steps"] / max(wall, 1e-9)}
     if record:
         from .replay import make_replay
 
-        return result, make_replay(result, bytes(history), game.state_hash(0)), result_timing
+        return result, make_replay(result, bytes(history), game.state_hash(0),
+                                   faults=bytes(fault_codes), max_faults=max_faults), result_timing
     return result, None, result_timing
 
 
-def _result(game, bots, seed, rounds, rules, faults, forfeit):
+def _cpu_seconds(rules, rounds, limits):
+    """CPU seconds a bot's process may use: its start-up and every frame at full budget."""
+    frames = (rounds + rules.max_extra_rounds) * (rules.max_round_frames + rules.post_round_delay)
+    if limits.cpu_seconds is not None:
+        return limits.cpu_seconds
+    return int(math.ceil(limits.startup + limits.overage + frames * limits.budget)) + 5
+
+
+def _result(game, bots, seed, rounds, rules, faults, forfeits, outputs):
     score = [int(x) for x in game.scores[0]]
-    if forfeit is not None:
-        winner = 1 - forfeit
+    forfeit = forfeits.index(True) if forfeits.count(True) == 1 else None
+    if any(forfeits):
+        winner = None if forfeit is None else 1 - forfeit
     elif game.errored(0):
         winner = None
     elif score[0] != score[1]:
@@ -117,9 +151,11 @@ def _result(game, bots, seed, rounds, rules, faults, forfeit):
         "rounds": game.rounds_played(0),
         "steps": int(game.frame[0]),
         "forfeit": None if forfeit is None else bots[forfeit],
+        "forfeits": [bool(f) for f in forfeits],
         "error": game.errored(0),
         "faults": [faults[0].to_dict(), faults[1].to_dict()],
         "seed": int(seed),
         "rounds_asked": int(rounds),
         "rules": rules.to_dict(),
+        "output": [o or {"text": "", "bytes": 0, "truncated": False} for o in outputs],
     }

@@ -32,7 +32,7 @@ from .match import bot_seed
 from .protocol import Action
 from .render import DIM_TEXT, SHIP_COLOURS, VIZ_HINT, Effects, scene
 from .rules import Rules
-from .seats import open_seat
+from .seats import Limits, open_seat
 
 BOT_BUDGET = 0.05  # seconds per bot action
 RENDER_CAP = 120  # most drawn frames a second
@@ -224,7 +224,10 @@ def play(p2="chaser", rules=None, seed=0, rounds=5, fps=60, scale=720, script=No
     from engine.clock import FixedStepClock
 
     game = Game(rules, seeds=[seed], rounds=rounds)  # checks seed and rounds
-    seat = open_seat(p2, bot_seed(seed, 1), budget=BOT_BUDGET)
+    seat = open_seat(p2, bot_seed(seed, 1), Limits(budget=BOT_BUDGET), rules)
+    if getattr(seat, "wait_ready", None) is not None and seat.wait_ready() is not None:
+        seat.close()
+        raise ValueError(f"bot {p2!r} could not start: {seat.dead[1]}")
     try:
         pygame.display.init()
         pygame.font.init()
@@ -304,7 +307,7 @@ def _run(pygame, screen, game, seat, p2, seed, rounds, fps, scale, source, max_s
                 paused_frames += 1
                 continue
             actions[0, 0] = action_code(held)
-            code, fault = seat.act(game.observe(0, 1))
+            code, fault = seat.act(game.raw_observation(0, 1))
             actions[0, 1] = code
             if fault is not None:
                 faults += 1

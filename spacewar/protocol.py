@@ -2,12 +2,17 @@
 
 A bot is any object with ``act(self, obs) -> Action``. It may also define ``reset(self)``,
 called at the start of every match. Built-in bots take an optional ``seed`` argument.
+
+An observation also exists as a flat float64 array of fixed length (``raw_layout``): that is
+what crosses from the match to a bot's own process (see ``spacewar.wire``), and
+``observation_from_raw`` turns it back into the same ``Observation`` on either side, so an
+isolated bot and an inline one see identical numbers. This module imports no compiled code.
 """
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import core
+from . import codes as core
 
 
 @dataclass(frozen=True)
@@ -33,8 +38,7 @@ class Action:
 
     def code(self):
         """The compact integer the compiled game takes (0 .. N_ACTIONS - 1)."""
-        return ((self.turn + 1) + 3 * bool(self.thrust) + 6 * bool(self.fire)
-                + 12 * bool(self.hyperspace) + 24 * bool(self.flip))
+        return action_code(self)
 
     @classmethod
     def from_code(cls, code):
@@ -46,6 +50,41 @@ class Action:
 
 
 NOOP = Action()
+
+
+def action_code(action):
+    """The code of ``action``, checked field by field whatever its class says of itself.
+
+    Raises ``ValueError`` naming the field for anything a genuine ``Action`` could not hold
+    (a forged ``turn`` set with ``object.__setattr__``, a subclass overriding ``code``).
+    """
+    if not isinstance(action, Action):
+        raise ValueError(f"not an Action: {type(action).__name__}")
+    turn = object.__getattribute__(action, "turn")
+    if type(turn) not in _TURN_TYPES or turn not in (-1, 0, 1):
+        raise ValueError(f"turn must be -1, 0 or 1, got {_short_repr(turn)}")
+    code = int(turn) + 1
+    for name, weight in (("thrust", 3), ("fire", 6), ("hyperspace", 12), ("flip", 24)):
+        value = object.__getattribute__(action, name)
+        if type(value) not in (bool, np.bool_):
+            raise ValueError(f"{name} must be True or False, got {_short_repr(value)}")
+        code += weight * bool(value)
+    return code
+
+
+# exact types only: a subclass of int could answer anything to ``in`` and ``int()``
+_TURN_TYPES = (int, float, np.int8, np.int16, np.int32, np.int64, np.float32, np.float64)
+
+
+def _short_repr(value):
+    """A repr that cannot raise and is at most 80 characters."""
+    try:
+        text = repr(value)
+    except BaseException:  # a hostile __repr__ must not escape
+        text = f"<{type(value).__name__} with a failing repr>"
+    if not isinstance(text, str):
+        text = f"<{type(value).__name__}>"
+    return text if len(text) <= 80 else text[:77] + "..."
 
 
 @dataclass(frozen=True)
@@ -114,3 +153,77 @@ def vector_layout(rules):
     for k in range(2 * rules.torpedoes):
         names += [f"torpedo{k}.{f}" for f in TORPEDO_FIELDS]
     return names
+
+
+# -- the observation as a flat array ------------------------------------------------------
+HEADER_FIELDS = ("frame", "round_frame", "round", "score_me", "score_enemy", "seat",
+                 "star_mu", "star_capture", "star_x", "star_y")
+RAW_SHIP_FIELDS = ("x", "y", "vx", "vy", "heading", "angular_velocity", "fuel", "torpedoes",
+                   "hyperspace", "alive", "in_hyperspace", "reload", "hyperspace_recharge",
+                   "charge", "flip_cooldown")
+RAW_TORPEDO_FIELDS = ("present", "x", "y", "vx", "vy", "mine", "ttl", "charge")
+_NH, _NS, _NT = len(HEADER_FIELDS), len(RAW_SHIP_FIELDS), len(RAW_TORPEDO_FIELDS)
+
+
+def raw_length(rules):
+    """Length of the raw observation array for these rules."""
+    return _NH + 2 * _NS + 2 * rules.torpedoes * _NT
+
+
+def raw_layout(rules):
+    """Names of the raw observation array's entries: header, me, enemy, then the torpedo
+    slots (own ones first), each slot with a presence flag."""
+    names = list(HEADER_FIELDS)
+    names += [f"me.{f}" for f in RAW_SHIP_FIELDS] + [f"enemy.{f}" for f in RAW_SHIP_FIELDS]
+    for k in range(2 * rules.torpedoes):
+        names += [f"torpedo{k}.{f}" for f in RAW_TORPEDO_FIELDS]
+    return names
+
+
+def _frozen(array):
+    array.setflags(write=False)
+    return array
+
+
+def _ship_from_raw(r):
+    return Ship(pos=_frozen(r[0:2].copy()), vel=_frozen(r[2:4].copy()), heading=float(r[4]),
+                angular_velocity=float(r[5]), fuel=float(r[6]), torpedoes=int(r[7]),
+                hyperspace=int(r[8]), alive=bool(r[9]), in_hyperspace=bool(r[10]),
+                reload=int(r[11]), hyperspace_recharge=int(r[12]), charge=float(r[13]),
+                flip_cooldown=int(r[14]))
+
+
+def _ship_vector(ship, rules):
+    return [ship.pos[0], ship.pos[1], ship.vel[0], ship.vel[1], np.cos(ship.heading),
+            np.sin(ship.heading), ship.angular_velocity, ship.fuel / max(rules.fuel, 1e-300),
+            ship.torpedoes / rules.torpedoes, ship.hyperspace / max(rules.hyperspace_jumps, 1),
+            float(ship.alive), float(ship.in_hyperspace), ship.reload / max(rules.reload, 1),
+            float(np.sign(ship.charge)), ship.flip_cooldown / max(rules.flip_cooldown, 1)]
+
+
+def observation_from_raw(raw, rules):
+    """The ``Observation`` a raw array describes (arrays in it are read-only copies)."""
+    raw = np.asarray(raw, dtype=np.float64)
+    if raw.shape != (raw_length(rules),):
+        raise ValueError(f"raw observation must have shape ({raw_length(rules)},), got {raw.shape}")
+    h = raw[:_NH]
+    me = _ship_from_raw(raw[_NH:_NH + _NS])
+    enemy = _ship_from_raw(raw[_NH + _NS:_NH + 2 * _NS])
+    slots = raw[_NH + 2 * _NS:].reshape(-1, _NT)
+    torpedoes = []
+    vec_t = np.zeros((slots.shape[0], 7))
+    for k, slot in enumerate(slots):
+        if slot[0] == 0.0:
+            continue
+        torpedoes.append(Torpedo(pos=_frozen(slot[1:3].copy()), vel=_frozen(slot[3:5].copy()),
+                                 mine=bool(slot[5]), ttl=int(slot[6]), charge=float(slot[7])))
+        vec_t[k] = (1.0, slot[1], slot[2], slot[3], slot[4], slot[5],
+                    slot[6] / max(rules.torpedo_life, 1))
+    vector = np.concatenate((_ship_vector(me, rules), _ship_vector(enemy, rules),
+                             [h[6] / max(rules.star_mu, 1e-300), h[1] / rules.max_round_frames],
+                             vec_t.ravel()))
+    return Observation(me=me, enemy=enemy, torpedoes=tuple(torpedoes),
+                       star_pos=_frozen(h[8:10].copy()), star_mu=float(h[6]),
+                       star_capture=float(h[7]), frame=int(h[0]), round_frame=int(h[1]),
+                       round=int(h[2]), score=(int(h[3]), int(h[4])), seat=int(h[5]),
+                       rules=rules, _vector=vector)

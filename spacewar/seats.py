@@ -1,185 +1,460 @@
-"""Seats: a bot at the table, isolated so that it can fail without taking the match down.
+"""Seats: a bot at the table, kept from harming the match whatever it does.
 
-A seat turns an observation into an action code and reports any fault:
+A seat turns a raw observation (``Game.raw_observation``) into an action code and reports any
+fault as ``(kind, message)``:
 
-- ``raised``: ``act`` raised an exception;
-- ``invalid``: it returned something that is not a ``spacewar.Action``;
-- ``timeout``: it took longer than the per-action time budget (its answer is discarded);
-- ``crashed``: its process died.
+- ``raised``: ``act`` raised (``SystemExit`` and ``KeyboardInterrupt`` included);
+- ``invalid``: it returned something that is not a valid ``spacewar.Action``, or its process
+  broke the wire protocol (the seat is then stopped);
+- ``timeout``: no answer within the per-action budget and what is left of the overage bank,
+  or over its CPU-time limit;
+- ``crashed``: its process died;
+- ``startup``: loading, constructing or resetting it failed, or took longer than the start-up
+  budget;
+- ``memory``: it ran out of its memory limit.
 
-Every fault costs the bot its turn (a no-op is played). ``InlineSeat`` calls the bot in this
-process (fast; a slow answer is discarded after the fact, but a bot that never returns would
-hang it, so it is for trusted, built-in bots). ``ProcessSeat`` runs the bot in a child process
-and stops waiting when the budget is spent, so even a bot stuck in an endless loop only loses
-turns; the child is killed when the match ends.
+Every fault costs the bot its turn (a no-op is played). A seat whose bot can no longer play
+(start-up failure, death, protocol breach, stopped after hanging) sets ``seat.dead`` and the
+match forfeits it at once.
+
+``InlineSeat`` calls a built-in bot in this process, on a read-only observation and a private
+copy of the rules. ``ProcessSeat`` runs any other bot in its own confined process
+(``spacewar.bothost``, ``spacewar.confinement``) and talks to it only in fixed-layout binary
+messages (``spacewar.wire``); the match never blocks on it: every wait has a deadline.
 """
-import multiprocessing
+import dataclasses
+import math
+import os
+import select
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
 import time
-import traceback
 
-from . import core
-from .bots import make_bot
-from .protocol import Action
+from . import codes, confinement, wire
+from .protocol import _short_repr, action_code, observation_from_raw
 
-FAULT_KINDS = ("raised", "invalid", "timeout", "crashed")
-
-
-def _check_action(result):
-    """The action code of a valid answer, or None."""
-    if isinstance(result, Action):
-        return result.code()
-    return None
+FAULT_KINDS = ("raised", "invalid", "timeout", "crashed", "startup", "memory")
+_KIND_BY_STATUS = {wire.RAISED: "raised", wire.INVALID: "invalid", wire.MEMORY: "memory"}
+SHOWN_OUTPUT = 4096  # bytes of a bot's stdout and stderr kept in the result
 
 
-def _describe(result):
-    text = repr(result)
-    return text if len(text) <= 80 else text[:77] + "..."
+@dataclasses.dataclass(frozen=True)
+class Limits:
+    """What a bot may spend. Times in seconds, sizes in MiB.
+
+    ``budget`` per action; ``overage``: a bank for the whole match that pays for answers over
+    the budget until it is spent (as Kaggle's environments do); ``startup``: import,
+    construction and ``reset``; ``stop_after``: a bot silent this long past its deadline is
+    stopped and forfeits. ``cpu_seconds``: CPU time for the bot's whole process (None: derived
+    from the match length); ``output_bytes``: stdout and stderr the bot may write.
+    """
+
+    budget: float = 0.05
+    overage: float = 1.0
+    startup: float = 10.0
+    stop_after: float = 2.0
+    memory_mb: int = 1024
+    cpu_seconds: int = None
+    scratch_mb: int = 64
+    file_mb: int = 1
+    max_files: int = 64
+    output_bytes: int = 1 << 16
+
+    def __post_init__(self):
+        for name in ("budget", "overage", "startup", "stop_after"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float)) \
+                    or not math.isfinite(value) or value < 0 or (value == 0 and name != "overage"):
+                raise ValueError(f"{name} must be a finite number of seconds > 0, got {value!r}")
+        for name in ("memory_mb", "scratch_mb", "file_mb", "max_files", "output_bytes"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+                raise ValueError(f"{name} must be an int >= 1, got {value!r}")
+        if self.cpu_seconds is not None and (isinstance(self.cpu_seconds, bool) or not isinstance(
+                self.cpu_seconds, int) or self.cpu_seconds < 1):
+            raise ValueError(f"cpu_seconds must be an int >= 1 or None, got {self.cpu_seconds!r}")
+
+
+class _Bank:
+    """The overage bank: time over the budget is paid from it while it lasts."""
+
+    def __init__(self, limits):
+        self.budget, self.left = limits.budget, limits.overage
+
+    def allowance(self):
+        return self.budget + self.left
+
+    def charge(self, elapsed):
+        """Pay for an answer that took ``elapsed`` s; False if it came too late."""
+        over = elapsed - self.budget
+        if over <= 0:
+            return True
+        if over <= self.left:
+            self.left -= over
+            return True
+        self.left = 0.0
+        return False
+
+    def late(self, elapsed):
+        return (f"answered after {elapsed * 1e3:.1f} ms (budget {self.budget * 1e3:.1f} ms, "
+                "overage bank spent)")
 
 
 class InlineSeat:
-    """A bot called directly in this process."""
+    """A built-in bot, or a bot object the caller made in its own process, called directly
+    here (trusted code, fast). Its faults, ``SystemExit`` and ``KeyboardInterrupt`` included,
+    cost it its turn; it sees a read-only observation and its own copy of the rules."""
 
-    def __init__(self, spec, seed, budget):
+    def __init__(self, spec, seed, limits, rules, bot=None):
+        from .bots import is_builtin, make_bot
+
+        if bot is None and not is_builtin(spec):
+            raise ValueError(f"inline seats are for built-in bots only, got {spec!r}: "
+                             "other bots run in their own process")
         self.spec = spec
-        self.bot = make_bot(spec, seed=seed)
-        self.budget = budget
+        self.rules = type(rules).from_dict(rules.to_dict())  # the bot may break only its own copy
+        self.bot = make_bot(spec, seed=seed) if bot is None else bot
+        self.bank = _Bank(limits)
+        self.dead = None
+        self.layers = ["in this process (built-in bot)"]
         reset = getattr(self.bot, "reset", None)
         if callable(reset):
             reset()
 
-    def act(self, obs):
+    def act(self, raw):
         """``(code, fault)``: fault is None or ``(kind, message)``."""
+        obs = observation_from_raw(raw, self.rules)
         start = time.perf_counter()
         try:
             result = self.bot.act(obs)
-        except Exception as exc:  # a bot's bug must not end the match
-            return core.NOOP, ("raised", f"{type(exc).__name__}: {exc}")
+        except MemoryError:
+            return codes.NOOP, ("memory", "MemoryError in act")
+        except BaseException as exc:  # SystemExit, KeyboardInterrupt included: a bot's fault
+            return codes.NOOP, ("raised", _exception_text(exc))
         elapsed = time.perf_counter() - start
-        if elapsed > self.budget:
-            return core.NOOP, ("timeout", f"answered after {elapsed * 1e3:.1f} ms "
-                                          f"(budget {self.budget * 1e3:.1f} ms)")
-        code = _check_action(result)
-        if code is None:
-            return core.NOOP, ("invalid", f"returned {_describe(result)}, not an Action")
-        return code, None
+        if not self.bank.charge(elapsed):
+            return codes.NOOP, ("timeout", self.bank.late(elapsed))
+        try:
+            return action_code(result), None
+        except ValueError as exc:
+            return codes.NOOP, ("invalid", f"returned {_short_repr(result)}: {exc}")
+        except BaseException as exc:
+            return codes.NOOP, ("invalid", _exception_text(exc))
 
     def close(self):
-        pass
+        return {"text": "", "bytes": 0, "truncated": False}
 
 
-def _child(conn, spec, seed):
-    """The child process of a ProcessSeat: answer each (frame, obs) with (frame, kind, payload)."""
+def _exception_text(exc):
     try:
-        bot = make_bot(spec, seed=seed)
-        reset = getattr(bot, "reset", None)
-        if callable(reset):
-            reset()
-        conn.send((-1, "ready", None))
-    except Exception as exc:
-        conn.send((-1, "raised", f"{type(exc).__name__}: {exc}"))
-        return
-    while True:
-        try:
-            message = conn.recv()
-        except (EOFError, OSError):
-            return
-        if message is None:
-            return
-        frame, obs = message
-        try:
-            result = bot.act(obs)
-            code = _check_action(result)
-            if code is None:
-                conn.send((frame, "invalid", f"returned {_describe(result)}, not an Action"))
-            else:
-                conn.send((frame, "ok", code))
-        except Exception as exc:
-            conn.send((frame, "raised", f"{type(exc).__name__}: {exc}"))
-        except BaseException:  # SystemExit, KeyboardInterrupt inside a bot: report and stop
-            conn.send((frame, "raised", traceback.format_exc(limit=1).strip().splitlines()[-1]))
-            return
+        text = f"{type(exc).__name__}: {exc}"
+    except BaseException:
+        text = f"{type(exc).__name__} (its message could not be shown)"
+    return text[:wire.MAX_TEXT]
 
 
-def _context():
-    methods = multiprocessing.get_all_start_methods()
-    return multiprocessing.get_context("fork" if "fork" in methods else "spawn")
+def _bot_environment(scratch):
+    env = {"PATH": "/usr/bin:/bin", "HOME": scratch, "TMPDIR": scratch, "LANG": "C.UTF-8",
+           "PYTHONHASHSEED": "0", "PYTHONNOUSERSITE": "1", "PYTHONDONTWRITEBYTECODE": "1",
+           "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1",
+           "NUMBA_NUM_THREADS": "1", "NUMBA_CACHE_DIR": os.path.join(scratch, "numba")}
+    for key in ("OPENBLAS_CORETYPE", "OPENBLAS_L2_SIZE"):  # keep numpy working on this CPU
+        if key in os.environ:
+            env[key] = os.environ[key]
+    return env
+
+
+def _bot_files(spec):
+    """``(read_dirs, list_dirs, search_path)`` the bot's own code needs, found without
+    running any of it."""
+    from .bots import locate
+
+    return locate(spec)
+
+
+def absolute_spec(spec):
+    from .bots import absolute_spec as absolute
+
+    return absolute(spec)
 
 
 class ProcessSeat:
-    """A bot in its own process, with a hard per-action time budget."""
+    """A bot in its own confined process. Construction starts it; ``wait_ready`` waits."""
 
-    def __init__(self, spec, seed, budget, start_timeout=30.0):
+    def __init__(self, spec, seed, limits, rules, cpu_seconds=None):
         self.spec = spec
-        self.budget = budget
-        ctx = _context()
-        self._conn, child_conn = ctx.Pipe()
-        self._proc = ctx.Process(target=_child, args=(child_conn, spec, seed), daemon=True)
-        self._proc.start()
-        child_conn.close()
-        self._frame = 0
-        self._dead = None
-        if not self._conn.poll(start_timeout):
-            self.close()
-            raise RuntimeError(f"bot {spec!r} did not start within {start_timeout} s")
-        _, kind, payload = self._conn.recv()
-        if kind != "ready":
-            self.close()
-            from .bots import BotLoadError
-            raise BotLoadError(f"bot {spec!r} failed to start: {payload}")
-
-    def act(self, obs):
-        if self._dead is not None:
-            return core.NOOP, ("crashed", self._dead)
-        self._frame += 1
+        self.limits = limits
+        self.bank = _Bank(limits)
+        self.dead = None
+        self.layers = []
+        self._pending = None  # (frame, time sent) of the observation awaiting an answer
+        self._reader = wire.AnswerReader()
+        self._proc = None
+        self._dir = tempfile.mkdtemp(prefix="spacewar-bot-")
+        scratch = os.path.join(self._dir, "scratch")
+        os.mkdir(scratch, 0o700)
+        self._log = os.path.join(self._dir, "output.log")
+        read_dirs, list_dirs, search_path = _bot_files(spec)
+        dirs, files = confinement.read_paths(extra_dirs=read_dirs)
+        namespaces = bool(confinement.launch_prefix())
+        config = {
+            "spec": absolute_spec(spec), "seed": int(seed), "rules": rules.to_dict(), "path": search_path,
+            "output_bytes": limits.output_bytes,
+            "confinement": {"numba_cache": _compiled_code_dir(),"scratch": scratch, "scratch_mb": limits.scratch_mb,
+                            "memory_mb": limits.memory_mb, "file_mb": limits.file_mb,
+                            "max_files": limits.max_files, "namespaces": namespaces,
+                            "cpu_seconds": cpu_seconds or limits.cpu_seconds or 3600,
+                            "read_dirs": dirs, "read_files": files, "list_dirs": list_dirs},
+        }
+        to_bot_r, self._to_bot = os.pipe()
+        self._from_bot, from_bot_w = os.pipe()
+        log_fd = os.open(self._log, os.O_WRONLY | os.O_CREAT | os.O_TRUNC | os.O_CLOEXEC, 0o600)
+        command = [*confinement.launch_prefix(), sys.executable, "-s", "-B", "-m",
+                   "spacewar.bothost", str(to_bot_r), str(from_bot_w)]
         try:
-            self._conn.send((self._frame, obs))
-        except (BrokenPipeError, OSError) as exc:
-            self._dead = f"bot process is gone ({type(exc).__name__})"
-            return core.NOOP, ("crashed", self._dead)
-        deadline = time.perf_counter() + self.budget
+            self._proc = subprocess.Popen(
+                command, stdin=subprocess.DEVNULL, stdout=log_fd, stderr=log_fd,
+                pass_fds=(to_bot_r, from_bot_w), close_fds=True, start_new_session=True,
+                cwd=scratch, env=_bot_environment(scratch),
+                preexec_fn=confinement.die_with_parent)
+        finally:
+            for fd in (to_bot_r, from_bot_w, log_fd):
+                os.close(fd)
+        os.set_blocking(self._to_bot, False)
+        os.set_blocking(self._from_bot, False)
+        self._started = time.monotonic()
+        if not self._send(wire.pack_start(config), self._started + limits.startup):
+            self._stop("startup", "did not read its start message")
+
+    # -- start-up ---------------------------------------------------------------------------
+    def wait_ready(self):
+        """None once the bot is ready, else the start-up fault ``(kind, message)``."""
+        if self.dead is not None:
+            return self.dead
+        deadline = self._started + self.limits.startup
         while True:
-            remaining = deadline - time.perf_counter()
+            answer = self._receive(deadline)
+            if answer is None:
+                if self.dead is not None:
+                    kind, message = self.dead
+                    self.dead = ("startup", f"died while starting: {message}")
+                    return self.dead
+                return self._stop("startup", f"not ready within the start-up budget of "
+                                             f"{self.limits.startup:g} s")
+            frame, status, code, text = answer
+            if status == wire.READY and frame == -1:
+                try:
+                    self.layers = [str(x) for x in __import__("json").loads(text)][:16]
+                except (ValueError, TypeError):
+                    self.layers = []
+                return None
+            if status in (wire.STARTUP, wire.MEMORY) and frame == -1:
+                kind = "memory" if status == wire.MEMORY else "startup"
+                return self._stop(kind, text or "start-up failed")
+            return self._stop("invalid", "broke the protocol while starting")
+
+    # -- play -------------------------------------------------------------------------------
+    def act(self, raw):
+        """``(code, fault)`` for one observation; never waits past the bot's allowance."""
+        if self.dead is not None:
+            return codes.NOOP, None
+        frame = int(raw[0])
+        if self._pending is not None:
+            late_frame, since = self._pending
+            answer = self._receive(time.monotonic())  # whatever has arrived, without waiting
+            if self.dead is not None:
+                return codes.NOOP, self.dead
+            if answer is not None:
+                self._pending = None  # the late answer to an earlier frame: already a no-op
+            elif time.monotonic() - since > self.bank.allowance() + self.limits.stop_after:
+                return codes.NOOP, self._stop(
+                    "timeout", f"stopped: no answer to frame {late_frame} for "
+                               f"{time.monotonic() - since:.1f} s")
+            else:
+                return codes.NOOP, ("timeout", f"still busy with frame {late_frame}")
+        sent = time.monotonic()
+        allowance = self.bank.allowance()
+        if not self._send(wire.pack_observe(frame, raw), sent + allowance):
+            return codes.NOOP, self._stop("timeout", "did not read its observation")
+        self._pending = (frame, sent)
+        answer = self._receive(sent + allowance)
+        if answer is None:
+            if self.dead is not None:
+                return codes.NOOP, self.dead
+            self.bank.left = 0.0
+            return codes.NOOP, ("timeout", f"no answer within {allowance * 1e3:.1f} ms "
+                                           "(budget and overage bank)")
+        self._pending = None
+        if not self.bank.charge(time.monotonic() - sent):
+            return codes.NOOP, ("timeout", self.bank.late(time.monotonic() - sent))
+        return self._judge(answer)
+
+    def _judge(self, answer):
+        _, status, code, text = answer
+        if status == wire.OK:
+            if 0 <= code < codes.N_ACTIONS:
+                return code, None
+            return codes.NOOP, ("invalid", f"action code {code} out of range [0, {codes.N_ACTIONS})")
+        if status in _KIND_BY_STATUS:
+            return codes.NOOP, (_KIND_BY_STATUS[status], text or wire.STATUS_NAMES[status])
+        return codes.NOOP, self._stop("invalid", f"broke the protocol: status "
+                                                 f"{wire.STATUS_NAMES[status]!r} during play")
+
+    # -- the pipes --------------------------------------------------------------------------
+    def _send(self, data, deadline):
+        view = memoryview(data)
+        while view:
             try:
-                ready = self._conn.poll(max(0.0, remaining))
-            except (EOFError, OSError):
-                ready = False
-            if not ready:
-                if not self._proc.is_alive():
-                    self._dead = f"bot process died (exit code {self._proc.exitcode})"
-                    return core.NOOP, ("crashed", self._dead)
-                return core.NOOP, ("timeout", f"no answer within {self.budget * 1e3:.1f} ms")
+                view = view[os.write(self._to_bot, view):]
+                continue
+            except BlockingIOError:
+                pass
+            except OSError:
+                self._died()
+                return False
+            remaining = deadline - time.monotonic()
+            if remaining <= 0 or not select.select([], [self._to_bot], [], remaining)[1]:
+                return False
+        return True
+
+    def _receive(self, deadline):
+        """The next answer, or None at the deadline or when the bot dies or misbehaves."""
+        while True:
             try:
-                frame, kind, payload = self._conn.recv()
-            except (EOFError, OSError):
-                self._dead = f"bot process died (exit code {self._proc.exitcode})"
-                return core.NOOP, ("crashed", self._dead)
-            if frame != self._frame:
-                continue  # a late answer to an earlier frame: already played as a no-op
-            if kind == "ok":
-                return payload, None
-            return core.NOOP, (kind, payload)
+                answer = self._reader.next()
+            except wire.WireError as exc:
+                self._stop("invalid", f"broke the protocol: {exc}")
+                return None
+            if answer is not None:
+                frame = answer[0]
+                expected = -1 if self._pending is None else self._pending[0]
+                if frame != expected:
+                    self._stop("invalid", f"broke the protocol: answered frame {frame}, "
+                                          f"asked {expected}")
+                    return None
+                return answer
+            remaining = deadline - time.monotonic()
+            if remaining > 0:
+                if not select.select([self._from_bot], [], [], remaining)[0]:
+                    return None
+            try:
+                data = os.read(self._from_bot, 1 << 16)
+            except BlockingIOError:
+                if remaining <= 0:
+                    return None
+                continue
+            except OSError:
+                data = b""
+            if not data:
+                self._died()
+                return None
+            try:
+                self._reader.feed(data)
+            except wire.WireError as exc:
+                self._stop("invalid", f"broke the protocol: {exc}")
+                return None
+
+    # -- ending -----------------------------------------------------------------------------
+    def _died(self):
+        try:
+            code = self._proc.wait(timeout=1.0)
+        except subprocess.TimeoutExpired:
+            code = None
+        if code is not None and code < 0 and -code == signal.SIGXCPU:
+            self.dead = ("timeout", "over its CPU-time limit")
+        elif code is not None and code < 0:
+            self.dead = ("crashed", f"bot process killed by {signal.Signals(-code).name}")
+        else:
+            self.dead = ("crashed", f"bot process exited (code {code})")
+        self._kill()
+
+    def _stop(self, kind, message):
+        self.dead = (kind, message)
+        self._kill()
+        return self.dead
+
+    def _kill(self):
+        if self._proc is None or self._proc.returncode is not None:
+            return
+        try:
+            os.killpg(self._proc.pid, signal.SIGKILL)  # the bot's session: it and all it started
+        except (ProcessLookupError, PermissionError):
+            pass
+        self._proc.kill()
+        self._proc.wait()
 
     def close(self):
-        try:
-            self._conn.send(None)
-        except (BrokenPipeError, OSError):
-            pass
-        self._proc.join(timeout=0.2)
-        if self._proc.is_alive():
-            self._proc.kill()
-            self._proc.join(timeout=1.0)
-        self._conn.close()
+        """Stop the bot (and everything it started); return its captured output."""
+        if self._proc is not None and self._proc.returncode is None:
+            if self._send(wire.pack_stop(), time.monotonic() + 0.05):
+                try:
+                    self._proc.wait(timeout=0.2)
+                except subprocess.TimeoutExpired:
+                    pass
+            self._kill()
+        for fd in (self._to_bot, self._from_bot):
+            try:
+                os.close(fd)
+            except OSError:
+                pass
+        self._to_bot = self._from_bot = -1
+        output = _read_output(self._log)
+        shutil.rmtree(self._dir, ignore_errors=True)
+        return output
+
+    def __del__(self):
+        if getattr(self, "_proc", None) is not None and self._proc.returncode is None:
+            self._kill()
 
 
-def open_seat(spec, seed, budget, isolation="auto"):
-    """A seat for bot ``spec``: ``inline``, ``process``, or ``auto`` (built-ins inline)."""
-    from .bots import BotLoadError, available, is_builtin
+def _compiled_code_dir():
+    from engine._cache import cache_dir
+
+    return cache_dir()
+
+
+def _read_output(path):
+    try:
+        with open(path, "rb") as f:
+            head = f.read(SHOWN_OUTPUT + 1)
+            size = os.fstat(f.fileno()).st_size
+    except OSError:
+        return {"text": "", "bytes": 0, "truncated": False}
+    return {"text": head[:SHOWN_OUTPUT].decode("utf-8", "replace"), "bytes": int(size),
+            "truncated": len(head) > SHOWN_OUTPUT}
+
+
+def bot_name(spec):
+    """The name a bot goes by in results: its specification, or for a bot object its class."""
+    if isinstance(spec, str):
+        return spec
+    cls = type(spec)
+    return f"{cls.__module__}.{cls.__qualname__}"
+
+
+def open_seat(spec, seed, limits=None, rules=None, isolation="auto", cpu_seconds=None):
+    """A seat for bot ``spec``: built-in bots inline (``auto``), every other bot named by a
+    string in its own confined process. ``isolation="process"`` puts built-in bots in a process
+    too; ``inline`` is refused for a named bot that is not built in. A bot *object* (anything
+    with ``act``) is the caller's own code and plays inline."""
+    from .bots import is_builtin, locate
+    from .rules import Rules
 
     if isolation not in ("auto", "inline", "process"):
         raise ValueError(f"isolation must be auto, inline or process, got {isolation!r}")
-    if not isinstance(spec, str) or (":" not in spec and not is_builtin(spec)):
-        raise BotLoadError(f"unknown bot {spec!r}; available: {', '.join(available())} "
-                           "(or give package.module:Class or path/to/file.py:Class)")
-    if isolation == "inline" or (isolation == "auto" and is_builtin(spec)):
-        return InlineSeat(spec, seed, budget)
-    return ProcessSeat(spec, seed, budget)
+    limits = Limits() if limits is None else limits
+    if isinstance(limits, (int, float)):
+        limits = Limits(budget=limits)  # the old call shape: a budget in seconds
+    rules = Rules() if rules is None else rules
+    if not isinstance(spec, str) and callable(getattr(spec, "act", None)):
+        return InlineSeat(bot_name(spec), seed, limits, rules, bot=spec)
+    if not is_builtin(spec):
+        locate(spec)  # a bad specification is an error here, before any process starts
+    if is_builtin(spec) and isolation != "process":
+        return InlineSeat(spec, seed, limits, rules)
+    if isolation == "inline":
+        raise ValueError(f"inline isolation is for built-in bots only, got {spec!r}")
+    return ProcessSeat(spec, seed, limits, rules, cpu_seconds=cpu_seconds)

@@ -5,6 +5,10 @@ gets the luckier seat). Match seeds derive from the tournament seed and the matc
 the schedule, and results are gathered in schedule order, so the same seed gives the same
 table whatever the number of workers.
 
+No bot's code runs in the tournament's processes: specifications are checked without
+importing them, and each non-built-in bot is loaded only in its own confined process. A bot
+that cannot start forfeits its matches; the table is printed all the same.
+
 Ratings are Elo-scale Bradley-Terry strengths fitted to all results at once (a draw counts
 half a win each way), which unlike sequential Elo updates does not depend on game order:
 P(i beats j) = 1 / (1 + 10^((R_j - R_i) / 400)). Each bot also plays one virtual draw
@@ -21,6 +25,7 @@ import numpy as np
 
 from .match import DEFAULT_BUDGET, DEFAULT_MAX_FAULTS, play_match
 from .rules import Rules
+from .seats import Limits
 
 
 def schedule(bots, games, seed):
@@ -35,9 +40,9 @@ def schedule(bots, games, seed):
 
 
 def _play(job):
-    p1, p2, match_seed, rounds, rules_dict, budget, max_faults, isolation = job
+    p1, p2, match_seed, rounds, rules_dict, limits, max_faults, isolation = job
     result, _, timing = play_match(p1, p2, seed=match_seed, rounds=rounds,
-                                   rules=Rules.from_dict(rules_dict), budget=budget,
+                                   rules=Rules.from_dict(rules_dict), limits=limits,
                                    max_faults=max_faults, isolation=isolation)
     return result, timing
 
@@ -74,8 +79,12 @@ def bradley_terry_elo(names, results, iterations=2000):
 
 
 def run_tournament(bots, games=10, seed=1, rounds=3, rules=None, workers=None, progress=True,
-                   budget=DEFAULT_BUDGET, max_faults=DEFAULT_MAX_FAULTS, isolation="auto"):
-    """Play the round robin; return the table and every match result (plain data)."""
+                   budget=DEFAULT_BUDGET, max_faults=DEFAULT_MAX_FAULTS, isolation="auto",
+                   limits=None):
+    """Play the round robin; return ``(report, stats)``: the table and every match result
+    (plain data), and the frames played and match seconds. ``limits`` (a
+    ``spacewar.seats.Limits``) sets every budget of the bots; ``budget`` alone the per-action
+    one."""
     bots = list(bots)
     if len(bots) < 2:
         raise ValueError(f"a tournament needs at least two bots, got {bots!r}")
@@ -83,15 +92,16 @@ def run_tournament(bots, games=10, seed=1, rounds=3, rules=None, workers=None, p
         raise ValueError(f"each bot may enter once, got {bots!r}")
     if isinstance(games, bool) or not isinstance(games, int) or games < 1:
         raise ValueError(f"games must be an int >= 1, got {games!r}")
-    from .bots import load_bot_class
+    from .bots import locate
 
     for spec in bots:
-        load_bot_class(spec)  # unknown names fail here, before any work starts
+        locate(spec)  # unknown names and missing files fail here; no bot code runs here
     rules = Rules() if rules is None else rules
     workers = (os.cpu_count() or 1) if workers is None else workers
     if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
         raise ValueError(f"workers must be an int >= 1, got {workers!r}")
-    jobs = [(p1, p2, s, rounds, rules.to_dict(), budget, max_faults, isolation)
+    limits = Limits(budget=budget) if limits is None else limits
+    jobs = [(p1, p2, s, rounds, rules.to_dict(), limits, max_faults, isolation)
             for p1, p2, s in schedule(bots, games, seed)]
     if workers > 1:
         _warm_up(rules)
@@ -119,7 +129,7 @@ def run_tournament(bots, games=10, seed=1, rounds=3, rules=None, workers=None, p
         "rules": rules.to_dict(), "table": table,
         "matches": [{"p1": r["bots"][0], "p2": r["bots"][1], "seed": r["seed"],
                      "winner": r["winner"], "score": r["score"], "steps": r["steps"],
-                     "forfeit": r["forfeit"],
+                     "forfeit": r["forfeit"], "forfeits": r["forfeits"],
                      "faults": [r["faults"][0]["total"], r["faults"][1]["total"]]}
                     for r in matches],
     }, {"frames": frames, "match_seconds": wall}
@@ -137,7 +147,7 @@ def _table(bots, matches):
             row["points_for"] += r["score"][seat]
             row["points_against"] += r["score"][1 - seat]
             row["faults"] += r["faults"][seat]["total"]
-            row["forfeits"] += int(r["forfeit"] == me)
+            row["forfeits"] += int(r["forfeits"][seat])
             if r["winner_seat"] is None:
                 row["draws"] += 1
             elif r["winner_seat"] == seat:

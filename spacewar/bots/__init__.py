@@ -4,6 +4,7 @@ A bot is any class with ``act(self, obs) -> spacewar.Action``; it may define ``r
 (called when a match starts) and accept a ``seed`` keyword (built-in bots do).
 """
 import importlib
+import importlib.machinery
 import importlib.util
 import inspect
 import os
@@ -29,7 +30,67 @@ def available():
 
 
 def is_builtin(spec):
-    return spec in BUILTIN
+    return isinstance(spec, str) and spec in BUILTIN
+
+
+def _split(spec):
+    if not isinstance(spec, str) or not spec:
+        raise BotLoadError(f"bot must be a name or 'module:Class' string, got {spec!r}")
+    target = BUILTIN.get(spec, spec)
+    if ":" not in target:
+        raise BotLoadError(f"unknown bot {spec!r}; available: {', '.join(available())} "
+                           "(or give package.module:Class or path/to/file.py:Class)")
+    where, class_name = target.rsplit(":", 1)
+    if not class_name.isidentifier():
+        raise BotLoadError(f"{class_name!r} in bot {spec!r} is not a class name")
+    return where, class_name
+
+
+def _is_file_spec(where):
+    return where.endswith(".py") or os.sep in where or "/" in where
+
+
+def locate(spec):
+    """Where a bot's code lives, found without running any of it.
+
+    Returns ``(read_dirs, list_dirs, search_path)``: what its process must be able to read,
+    the directories it must be able to list to import it, and the directory to put first on
+    its ``sys.path`` (or None). Raises ``BotLoadError`` for a specification that cannot name
+    a bot: unknown name, missing file, module not found. Whether the module imports, and has
+    the class, is learnt in the bot's own process.
+    """
+    where, _ = _split(spec)
+    if is_builtin(spec):
+        return [], [], None
+    if _is_file_spec(where):
+        path = os.path.abspath(where)
+        if not os.path.isfile(path):
+            raise BotLoadError(f"bot file {where!r} does not exist")
+        return [os.path.dirname(path)], [], None
+    top = where.split(".")[0]
+    if not all(part.isidentifier() for part in where.split(".")):
+        raise BotLoadError(f"{where!r} in bot {spec!r} is not a module name")
+    search = [os.getcwd()] + [p for p in sys.path if p]
+    found = importlib.machinery.PathFinder.find_spec(top, search)
+    if found is None:
+        raise BotLoadError(f"cannot import module {where!r} for bot {spec!r}: "
+                           f"no module named {top!r} in the current directory or on sys.path")
+    if found.submodule_search_locations:
+        roots = list(found.submodule_search_locations)
+    elif found.origin:
+        roots = [found.origin]
+    else:
+        raise BotLoadError(f"module {top!r} for bot {spec!r} has no files to load")
+    parents = sorted({os.path.dirname(os.path.abspath(r)) for r in roots})
+    return roots, parents, parents[0]
+
+
+def absolute_spec(spec):
+    """``spec`` with a bot file's path made absolute (a bot's process starts elsewhere)."""
+    where, class_name = _split(spec)
+    if not is_builtin(spec) and _is_file_spec(where):
+        return f"{os.path.abspath(where)}:{class_name}"
+    return spec
 
 
 def _import_from_file(path, class_name):
@@ -53,14 +114,8 @@ def _import_from_file(path, class_name):
 
 def load_bot_class(spec):
     """The bot class named by ``spec`` (a built-in name, ``module:Class`` or ``file.py:Class``)."""
-    if not isinstance(spec, str) or not spec:
-        raise BotLoadError(f"bot must be a name or 'module:Class' string, got {spec!r}")
-    target = BUILTIN.get(spec, spec)
-    if ":" not in target:
-        raise BotLoadError(f"unknown bot {spec!r}; available: {', '.join(available())} "
-                           "(or give package.module:Class or path/to/file.py:Class)")
-    where, class_name = target.rsplit(":", 1)
-    if where.endswith(".py") or os.sep in where or "/" in where:
+    where, class_name = _split(spec)
+    if _is_file_spec(where):
         cls, origin = _import_from_file(where, class_name)
     else:
         try:

@@ -1,0 +1,151 @@
+"""The bot's own process: confine itself, load the bot, answer observations over the wire.
+
+Started by ``spacewar.seats.ProcessSeat`` as ``python -I -m spacewar.bothost IN OUT`` (the
+file descriptors of its two pipes), possibly under ``unshare``. Nothing of the bot runs
+before ``confinement.confine`` has applied every layer; from then on the bot's module is
+imported, its class checked, constructed and reset here, and the match only ever learns
+"ready" or a start-up fault with a message. Its answers are checked here for helpful messages,
+and again by the match, which trusts nothing that arrives.
+"""
+import io
+import json
+import os
+import sys
+
+from . import wire
+
+
+def _read_exact(fd, n):
+    chunks = []
+    while n:
+        chunk = os.read(fd, n)
+        if not chunk:
+            raise EOFError
+        chunks.append(chunk)
+        n -= len(chunk)
+    return b"".join(chunks)
+
+
+def _write_all(fd, data):
+    view = memoryview(data)
+    while view:
+        view = view[os.write(fd, view):]
+
+
+class _CappedOutput(io.RawIOBase):
+    """The bot's stdout and stderr: the first ``cap`` bytes reach the file, the rest is
+    counted and dropped (so a flood neither fills a disk nor raises in the bot)."""
+
+    def __init__(self, fd, cap):
+        self.fd, self.cap, self.seen = fd, cap, 0
+
+    def writable(self):
+        return True
+
+    def write(self, data):
+        room = self.cap - self.seen
+        self.seen += len(data)
+        if room > 0:
+            try:
+                _write_all(self.fd, bytes(data[:room]))
+            except OSError:
+                pass
+        return len(data)
+
+
+def _message(exc):
+    """``Kind: text`` of an exception, capped, even when its ``__str__`` misbehaves."""
+    try:
+        text = f"{type(exc).__name__}: {exc}"
+    except BaseException:
+        text = f"{type(exc).__name__} (its message could not be shown)"
+    return text[:wire.MAX_TEXT]
+
+
+def _capture_output(cap):
+    raw = _CappedOutput(1, cap)
+    stream = io.TextIOWrapper(io.BufferedWriter(raw), encoding="utf-8", errors="replace",
+                              line_buffering=True)
+    sys.stdout = sys.stderr = stream
+
+
+def _load(config):
+    from .bots import make_bot
+    from .rules import Rules
+
+    if config.get("path"):
+        sys.path.insert(0, config["path"])
+    bot = make_bot(config["spec"], seed=config["seed"])
+    reset = getattr(bot, "reset", None)
+    if callable(reset):
+        reset()
+    return bot, Rules.from_dict(config["rules"])
+
+
+def _answer(bot, rules, frame, raw):
+    from .protocol import action_code, observation_from_raw
+
+    obs = observation_from_raw(raw, rules)
+    try:
+        result = bot.act(obs)
+    except MemoryError:
+        return wire.pack_answer(frame, wire.MEMORY, 0, "MemoryError in act")
+    except BaseException as exc:  # SystemExit and KeyboardInterrupt from a bot are its faults
+        return wire.pack_answer(frame, wire.RAISED, 0, _message(exc))
+    try:
+        return wire.pack_answer(frame, wire.OK, action_code(result))
+    except ValueError as exc:
+        return wire.pack_answer(frame, wire.INVALID, 0, f"returned an invalid answer: {exc}")
+    except BaseException as exc:
+        return wire.pack_answer(frame, wire.INVALID, 0, _message(exc))
+
+
+def main(argv):
+    fd_in, fd_out = int(argv[1]), int(argv[2])
+    try:
+        config = wire.read_start(lambda n: _read_exact(fd_in, n))
+    except (EOFError, OSError, ValueError):
+        os._exit(2)
+    from . import confinement
+
+    try:
+        layers = confinement.confine(config["confinement"])
+    except BaseException as exc:
+        _write_all(fd_out, wire.pack_answer(-1, wire.STARTUP, 0,
+                                            "confinement failed: " + _message(exc)))
+        os._exit(3)
+    _capture_output(int(config["output_bytes"]))
+    try:
+        bot, rules = _load(config)
+    except MemoryError:
+        _write_all(fd_out, wire.pack_answer(-1, wire.MEMORY, 0, "MemoryError while starting"))
+        os._exit(4)
+    except BaseException as exc:
+        _write_all(fd_out, wire.pack_answer(-1, wire.STARTUP, 0, _message(exc)))
+        os._exit(4)
+    _write_all(fd_out, wire.pack_answer(-1, wire.READY, 0, json.dumps(layers)))
+    while True:
+        try:
+            message = wire.read_observe(lambda n: _read_exact(fd_in, n))
+        except (EOFError, OSError, ValueError):
+            break
+        if message is None:
+            break
+        frame, raw = message
+        try:
+            answer = _answer(bot, rules, frame, raw)
+        except MemoryError:
+            answer = wire.pack_answer(frame, wire.MEMORY, 0, "MemoryError")
+        try:
+            _write_all(fd_out, answer)
+        except OSError:
+            break
+    try:
+        sys.stdout.flush()
+    except BaseException:
+        pass
+    os._exit(0)
+
+
+if __name__ == "__main__":
+    main(sys.argv)

@@ -1,0 +1,238 @@
+"""Confinement of a bot's process, with what the operating system gives.
+
+Two halves. The match side (``launch_prefix``) starts the bot host under util-linux's
+``unshare`` when this machine allows it: a new user namespace (the bot holds no capability
+outside it), PID namespace (it sees and can signal only its own processes, and when its first
+process dies the kernel kills every other one), network namespace (no interface but a downed
+loopback), IPC, UTS and mount namespaces with a private /proc. ``--kill-child`` and a
+parent-death signal (``PR_SET_PDEATHSIG``) tie the whole tree to the match process: if the
+match dies, so does the bot, whatever it started.
+
+The bot side (``confine``), run by ``spacewar.bothost`` before the bot's module is imported:
+
+- a size-limited tmpfs as its only writable directory (inside its mount namespace);
+- resource limits (``setrlimit``): address space, CPU seconds, open files, file size, no core
+  files, and one process (``RLIMIT_NPROC``: no fork, no thread);
+- Landlock: reads only beneath the Python installation, the project's packages, shared
+  libraries and the bot's own files; writes only in the scratch directory; no TCP; no signal
+  or abstract UNIX socket beyond its own domain;
+- seccomp (through ``pyseccomp``, a binding to libseccomp): ``socket``, process creation,
+  ``ptrace`` and the other calls a bot never needs fail with EPERM;
+- every capability dropped (bounding set, effective, permitted, inheritable) and
+  ``no_new_privs`` set.
+
+Each layer is applied where the machine has it and reported by name; ``spacewar sandbox``
+prints which ones hold here (``docs/game.md``, "Running untrusted bots").
+"""
+import ctypes
+import errno
+import functools
+import os
+import resource
+import shutil
+import signal
+import subprocess
+import sys
+
+UNSHARE_FLAGS = ("--user", "--map-root-user", "--pid", "--fork", "--kill-child", "--net",
+                 "--ipc", "--uts", "--mount-proc")
+_PR_SET_PDEATHSIG, _PR_CAPBSET_DROP = 1, 24
+_MS_NOSUID, _MS_NODEV, _MS_NOEXEC = 2, 4, 8
+
+#: system calls a bot never needs (each fails with EPERM); missing ones on an arch are skipped
+DENIED_SYSCALLS = (
+    "socket", "fork", "vfork", "clone", "clone3", "execve", "execveat", "ptrace", "process_vm_readv",
+    "process_vm_writev", "kcmp", "pidfd_open", "pidfd_getfd", "pidfd_send_signal", "bpf",
+    "perf_event_open", "userfaultfd", "io_uring_setup", "io_uring_enter", "io_uring_register",
+    "mount", "umount2", "move_mount", "fsopen", "fsmount", "open_tree", "pivot_root", "chroot",
+    "unshare", "setns", "keyctl", "add_key", "request_key", "init_module", "finit_module",
+    "delete_module", "kexec_load", "kexec_file_load", "reboot", "swapon", "swapoff", "acct",
+    "quotactl", "mknod", "mknodat", "setuid", "setgid", "setreuid", "setregid", "setresuid",
+    "setresgid", "setgroups",
+)
+
+
+# -- the match's side ------------------------------------------------------------------------
+@functools.lru_cache(maxsize=None)
+def namespaces_available():
+    """Whether ``unshare`` can give a bot its own user, PID, network and mount namespaces."""
+    if not sys.platform.startswith("linux") or shutil.which("unshare") is None:
+        return False
+    try:
+        done = subprocess.run(["unshare", *UNSHARE_FLAGS, "true"], stdin=subprocess.DEVNULL,
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, timeout=10)
+    except (OSError, subprocess.SubprocessError):
+        return False
+    return done.returncode == 0
+
+
+def launch_prefix():
+    """The command words that start a bot host in its own namespaces (empty if unavailable)."""
+    return [shutil.which("unshare"), *UNSHARE_FLAGS, "--"] if namespaces_available() else []
+
+
+def die_with_parent():
+    """``preexec_fn`` for the bot's first process: SIGKILL it when the match's thread dies."""
+    parent = os.getppid()
+    if sys.platform.startswith("linux"):
+        ctypes.CDLL(None, use_errno=True).prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
+    if os.getppid() != parent:  # the parent died before the death signal was armed
+        os._exit(1)
+
+
+# -- the bot's side --------------------------------------------------------------------------
+def confine(config):
+    """Apply every layer this machine has, in the order each needs; return their names.
+
+    ``config`` keys: ``scratch`` (directory), ``scratch_mb``, ``memory_mb``, ``cpu_seconds``,
+    ``max_files``, ``file_mb``, ``read_dirs``, ``read_files``, ``list_dirs``,
+    ``namespaces`` (whether the launcher gave namespaces).
+    """
+    layers = []
+    libc = ctypes.CDLL(None, use_errno=True) if sys.platform.startswith("linux") else None
+    if libc is not None:
+        libc.prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
+        layers.append("parent-death signal")
+    if config.get("namespaces"):
+        layers.append("namespaces (user, pid, net, ipc, uts, mount)")
+        if _mount_scratch(libc, config["scratch"], config["scratch_mb"]):
+            layers.append(f"scratch tmpfs {config['scratch_mb']} MiB")
+    _copy_compiled_code(config.get("numba_cache"), config["scratch"])
+    os.chdir(config["scratch"])
+    _limit_resources(config)
+    layers.append("rlimits")
+    if libc is not None:
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # an over-long write fails, not the bot
+        seccomp = _load_seccomp()  # before Landlock: finding libseccomp reads and runs ldconfig
+        _drop_bounding_set(libc)
+        try:
+            from . import landlock
+
+            abi = landlock.restrict(read_dirs=config["read_dirs"],
+                                    read_files=config["read_files"],
+                                    list_dirs=config["list_dirs"],
+                                    write_dirs=[config["scratch"]],
+                                    write_files=["/dev/null"])
+            layers.append(f"landlock abi {abi}")
+        except OSError:
+            pass
+        if seccomp is not None and _seccomp(seccomp):
+            layers.append("seccomp")
+        if _drop_capabilities(libc):
+            layers.append("no capabilities")
+    return layers
+
+
+def _copy_compiled_code(source, scratch):
+    """A copy of the project's compiled code in the scratch directory (numba loads its cache
+    only from a writable directory), so a bot using the engine's kernels does not compile them."""
+    if not source or not os.path.isdir(source):
+        return
+    try:
+        shutil.copytree(source, os.path.join(scratch, "numba", os.path.basename(source)))
+    except OSError:
+        pass  # no room: the bot compiles what it uses
+
+
+def _mount_scratch(libc, path, size_mb):
+    """A private tmpfs over the scratch directory: bounded in size and inodes, no exec."""
+    options = f"size={int(size_mb)}m,nr_inodes=4096,mode=0700".encode()
+    flags = _MS_NOSUID | _MS_NODEV | _MS_NOEXEC
+    return libc.mount(b"tmpfs", os.fsencode(path), b"tmpfs", flags, options) == 0
+
+
+def _limit_resources(config):
+    mib = 1 << 20
+    limits = [(resource.RLIMIT_AS, int(config["memory_mb"]) * mib),
+              (resource.RLIMIT_FSIZE, int(config["file_mb"]) * mib),
+              (resource.RLIMIT_CORE, 0),
+              (resource.RLIMIT_NOFILE, int(config["max_files"]))]
+    if hasattr(resource, "RLIMIT_NPROC"):
+        limits.append((resource.RLIMIT_NPROC, 1))
+    for which, value in limits:
+        _lower(which, value, value)
+    cpu = int(config["cpu_seconds"])
+    _lower(resource.RLIMIT_CPU, cpu, cpu + 1)  # SIGXCPU at the soft limit, SIGKILL a second later
+
+
+def _lower(which, soft, hard):
+    old_soft, old_hard = resource.getrlimit(which)
+    if old_hard != resource.RLIM_INFINITY:
+        hard = min(hard, old_hard)
+    resource.setrlimit(which, (min(soft, hard), hard))
+
+
+def _drop_bounding_set(libc):
+    for cap in range(64):
+        if libc.prctl(_PR_CAPBSET_DROP, cap, 0, 0, 0) != 0 and ctypes.get_errno() == errno.EINVAL:
+            break  # past the last capability this kernel knows
+
+
+class _CapHeader(ctypes.Structure):
+    _fields_ = [("version", ctypes.c_uint32), ("pid", ctypes.c_int)]
+
+
+class _CapData(ctypes.Structure):
+    _fields_ = [("effective", ctypes.c_uint32), ("permitted", ctypes.c_uint32),
+                ("inheritable", ctypes.c_uint32)]
+
+
+def _drop_capabilities(libc):
+    header = _CapHeader(version=0x20080522, pid=0)  # _LINUX_CAPABILITY_VERSION_3
+    data = (_CapData * 2)()
+    return libc.capset(ctypes.byref(header), data) == 0
+
+
+def _load_seccomp():
+    """The ``pyseccomp`` module with libseccomp loaded, or None where either is missing."""
+    try:
+        import pyseccomp
+
+        pyseccomp.SyscallFilter(pyseccomp.ALLOW)
+    except (ImportError, RuntimeError, OSError, AttributeError):
+        return None
+    return pyseccomp
+
+
+def _seccomp(pyseccomp):
+    try:
+        rules = pyseccomp.SyscallFilter(pyseccomp.ALLOW)
+        for name in DENIED_SYSCALLS:
+            try:
+                rules.add_rule(pyseccomp.ERRNO(errno.EPERM), name)
+            except (RuntimeError, ValueError, OSError):
+                continue  # not a system call on this architecture
+        rules.load()
+    except (RuntimeError, OSError, AttributeError):
+        return False
+    return True
+
+
+def read_paths(extra_dirs=(), extra_files=()):
+    """What a bot may read: the interpreter and its libraries, the project's packages, the
+    system's shared libraries, then the bot's own files (``extra_*``)."""
+    import site
+    import sysconfig
+
+    import numpy
+
+    dirs = {sys.base_prefix, sys.prefix, sys.exec_prefix,
+            os.path.dirname(os.path.realpath(sys.executable)),
+            os.path.dirname(os.path.abspath(__file__)),
+            os.path.dirname(os.path.dirname(numpy.__file__))}
+    for key in ("stdlib", "platstdlib", "purelib", "platlib"):
+        dirs.add(sysconfig.get_paths()[key])
+    try:
+        dirs.update(site.getsitepackages())
+    except AttributeError:
+        pass
+    import engine
+
+    project = os.path.dirname(os.path.dirname(os.path.abspath(engine.__file__)))
+    for package in ("engine", "spacewar", "validation"):  # the compiled-code cache hashes all three
+        dirs.add(os.path.join(project, package))
+    dirs.update(("/lib", "/lib64", "/usr/lib", "/usr/lib64", "/usr/local/lib",
+                 "/sys/devices/system/cpu"))
+    dirs.update(extra_dirs)
+    files = {"/etc/ld.so.cache", "/dev/urandom", "/dev/random", "/dev/zero", *extra_files}
+    return sorted(d for d in dirs if d), sorted(files)

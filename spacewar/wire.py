@@ -1,0 +1,119 @@
+"""The wire between a match and a bot's own process: fixed-layout binary messages, no pickle.
+
+Every message starts with a 4-byte magic and has a fixed-size header (little-endian,
+``struct`` formats below); the only variable parts are a length-prefixed payload whose
+length the reader checks against a cap before reading it. The match never evaluates anything
+the bot sends: it unpacks integers and bytes, checks each field, and treats anything else as
+a fault of that bot.
+
+match -> bot
+  START   ``SWS1`` u32 length, then that many bytes of UTF-8 JSON (the bot's configuration)
+  OBSERVE ``SWO1`` i64 frame, u32 count, then count float64 (``spacewar.protocol.raw_layout``)
+  STOP    ``SWQ1`` i64 0, u32 0
+
+bot -> match
+  ANSWER  ``SWA1`` i64 frame, u8 status, u8 action code, u16 text length, then the text
+          (UTF-8, at most ``MAX_TEXT`` bytes; an error message or nothing)
+
+Statuses: READY (start-up done, frame -1), OK (the code is the action), RAISED (act raised;
+the text is the message), INVALID (act returned something that is not an Action), STARTUP
+(loading, constructing or resetting failed), MEMORY (the bot ran out of memory).
+"""
+import json
+import struct
+
+import numpy as np
+
+START_MAGIC, OBSERVE_MAGIC, STOP_MAGIC, ANSWER_MAGIC = b"SWS1", b"SWO1", b"SWQ1", b"SWA1"
+START_HEADER = struct.Struct("<4sI")
+OBSERVE_HEADER = struct.Struct("<4sqI")
+ANSWER_HEADER = struct.Struct("<4sqBBH")
+
+READY, OK, RAISED, INVALID, STARTUP, MEMORY = range(6)
+STATUS_NAMES = {READY: "ready", OK: "ok", RAISED: "raised", INVALID: "invalid",
+                STARTUP: "startup", MEMORY: "memory"}
+MAX_TEXT = 1024
+MAX_START = 1 << 16
+MAX_FLOATS = 1 << 12
+
+
+class WireError(ValueError):
+    """A message that breaks the protocol (the sender is at fault)."""
+
+
+# -- match -> bot ---------------------------------------------------------------------------
+def pack_start(config):
+    data = json.dumps(config, sort_keys=True).encode()
+    if len(data) > MAX_START:
+        raise WireError(f"start message of {len(data)} bytes exceeds {MAX_START}")
+    return START_HEADER.pack(START_MAGIC, len(data)) + data
+
+
+def pack_observe(frame, raw):
+    raw = np.ascontiguousarray(raw, dtype="<f8")
+    return OBSERVE_HEADER.pack(OBSERVE_MAGIC, int(frame), raw.size) + raw.tobytes()
+
+
+def pack_stop():
+    return OBSERVE_HEADER.pack(STOP_MAGIC, 0, 0)
+
+
+def read_start(read_exact):
+    """The configuration dict; ``read_exact(n)`` returns exactly n bytes or raises EOFError."""
+    magic, length = START_HEADER.unpack(read_exact(START_HEADER.size))
+    if magic != START_MAGIC or length > MAX_START:
+        raise WireError("bad start message")
+    return json.loads(read_exact(length).decode())
+
+
+def read_observe(read_exact):
+    """``(frame, raw)`` for an observation, or ``None`` for STOP."""
+    magic, frame, count = OBSERVE_HEADER.unpack(read_exact(OBSERVE_HEADER.size))
+    if magic == STOP_MAGIC:
+        return None
+    if magic != OBSERVE_MAGIC or count > MAX_FLOATS:
+        raise WireError("bad observe message")
+    return frame, np.frombuffer(read_exact(8 * count), dtype="<f8").astype(np.float64)
+
+
+# -- bot -> match ---------------------------------------------------------------------------
+def pack_answer(frame, status, code=0, text=""):
+    data = text.encode("utf-8", "replace")[:MAX_TEXT]
+    return ANSWER_HEADER.pack(ANSWER_MAGIC, int(frame), int(status), int(code), len(data)) + data
+
+
+class AnswerReader:
+    """Parses answers out of the bytes a bot sends, however they arrive in pieces.
+
+    ``feed(data)`` adds bytes; ``next()`` returns ``(frame, status, code, text)`` for each
+    complete answer, ``None`` when more bytes are needed, and raises ``WireError`` as soon as
+    the stream cannot be an answer (wrong magic, unknown status, text over the cap).
+    """
+
+    def __init__(self):
+        self.buffer = bytearray()
+
+    def feed(self, data):
+        self.buffer += data
+        if len(self.buffer) > ANSWER_HEADER.size + MAX_TEXT + 64:
+            # more than one outstanding answer is never legitimate: the match asks one at a time
+            raise WireError(f"bot sent {len(self.buffer)} bytes without being asked")
+
+    def next(self):
+        if len(self.buffer) < ANSWER_HEADER.size:
+            if self.buffer and not ANSWER_MAGIC.startswith(bytes(self.buffer[:4])):
+                raise WireError("answer does not start with the protocol's magic")
+            return None
+        magic, frame, status, code, length = ANSWER_HEADER.unpack_from(self.buffer)
+        if magic != ANSWER_MAGIC:
+            raise WireError("answer does not start with the protocol's magic")
+        if status not in STATUS_NAMES:
+            raise WireError(f"unknown answer status {status}")
+        if length > MAX_TEXT:
+            raise WireError(f"answer text of {length} bytes exceeds {MAX_TEXT}")
+        end = ANSWER_HEADER.size + length
+        if len(self.buffer) < end:
+            return None
+        text = bytes(self.buffer[ANSWER_HEADER.size:end]).decode("utf-8", "replace")
+        del self.buffer[:end]
+        return frame, status, code, text
