@@ -11,7 +11,8 @@
 from ._cache import project_cache
 
 with project_cache():
-    from . import analytic, clock, diagnostics, forces, integrators
+    from . import analytic, atomic, clock, diagnostics, forces, integrators
+    from .atomic import OutputPathError, atomic_write, check_output_dir, check_output_path
     from .clock import FixedStepClock
     from .errors import SimulationError
     from .integrators import INTEGRATORS, ORDERS, SYMPLECTIC
@@ -20,4 +21,5 @@ with project_cache():
 __version__ = "0.1.0"
 
 __all__ = ["Simulation", "SimulationError", "INTEGRATORS", "ORDERS", "SYMPLECTIC", "forces", "integrators",
-           "analytic", "clock", "diagnostics", "FixedStepClock", "__version__"]
+           "analytic", "clock", "diagnostics", "FixedStepClock", "__version__", "atomic",
+           "atomic_write", "check_output_path", "check_output_dir", "OutputPathError"]

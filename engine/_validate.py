@@ -4,10 +4,41 @@ import numbers
 
 import numpy as np
 
+#: Largest step count a single compiled call takes (``step(n)``, the steps ``integrate`` needs):
+#: well inside the int64 the kernels count in, so ``steps + n`` and ``(step + 1) * h`` never
+#: overflow the counter.
+MAX_STEPS = 2 ** 62
+
+_TEXT = (str, bytes, bytearray)
+_BOOLS = (bool, np.bool_)
+
+
+def _not_a_number(value):
+    """True for values that convert to a float but are not numbers: text and booleans."""
+    if isinstance(value, _TEXT + _BOOLS):
+        return True
+    return isinstance(value, np.ndarray) and value.dtype.kind not in "iuf"
+
+
+def _items(value, raw):
+    """The Python objects of a nested list (numpy's inferred dtype hides bools among numbers)."""
+    out = np.empty(raw.shape, dtype=object)
+    try:
+        out[...] = value
+    except (TypeError, ValueError):
+        return raw.astype(object)
+    return out
+
 
 def finite_float(name, value):
-    """Return ``value`` as a finite float or raise naming ``name`` and the value."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+    """Return ``value`` as a finite float or raise naming ``name`` and the value.
+
+    Text (``'1'``) and booleans are refused (TypeError): they convert to a float, but a string
+    or ``True`` given as a number is a bug, not a value.
+    """
+    if _not_a_number(value):
+        raise TypeError(f"{name} must be a real number, got {value!r} ({type(value).__name__})")
+    if not isinstance(value, numbers.Real):
         try:
             value = float(value)
         except (TypeError, ValueError):
@@ -32,12 +63,90 @@ def positive_float(name, value):
     return value
 
 
+def real_array(name, value, what="numbers"):
+    """``value`` as a new float64 array; text, booleans and complex numbers are a TypeError.
+
+    ``np.array('1', dtype=float)`` and ``np.array(True, dtype=float)`` succeed, so the dtype
+    numpy infers is checked first: only integers and floats (or objects that are real numbers)
+    pass.
+    """
+    if isinstance(value, _TEXT):
+        raise TypeError(f"{name} must be {what}, got {value!r} (str)")
+    try:
+        raw = np.asarray(value)
+    except (TypeError, ValueError):
+        raise TypeError(f"{name} must be {what}, got {value!r}") from None
+    kind = raw.dtype.kind
+    if isinstance(value, (list, tuple)) and kind in "iuf":
+        kind = "O"  # numpy reads (True, 0.0) as floats: look at the items themselves
+        raw = _items(value, raw)
+    if kind == "O":
+        for item in raw.reshape(-1):
+            if isinstance(item, _BOOLS) or not isinstance(item, numbers.Real):
+                raise TypeError(f"{name} must be {what}, got {item!r} ({type(item).__name__}) "
+                                f"in {value!r}")
+    elif kind not in "iuf":
+        shown = raw.reshape(-1)[0].item() if raw.size else value
+        raise TypeError(f"{name} must be {what}, got {shown!r} ({type(shown).__name__}) "
+                        f"in {value!r}")
+    try:
+        return np.array(raw, dtype=np.float64)
+    except (TypeError, ValueError, OverflowError):
+        raise TypeError(f"{name} must be {what}, got {value!r}") from None
+
+
+def index_array(name, value, width=None):
+    """``value`` as a new int64 array of particle indices (shape (M, width), or 1-D).
+
+    Only integers pass: floats (``0.0``), booleans and text are a TypeError even when they
+    would convert, and an index too large for int64 is a ValueError.
+    """
+    shape = f"(M, {width})" if width else "a list of"
+    what = f"{shape} integer particle indices"
+    if isinstance(value, _TEXT):
+        raise TypeError(f"{name} must be {what}, got {value!r} (str)")
+    try:
+        raw = np.asarray(value)
+    except (TypeError, ValueError):
+        raise TypeError(f"{name} must be {what}, got {value!r}") from None
+    if raw.size == 0:
+        raw = np.zeros((0, width) if width else 0, dtype=np.int64)
+    kind = raw.dtype.kind
+    if isinstance(value, (list, tuple)) and kind in "iu":
+        kind = "O"  # numpy reads (True, 2) as ints: look at the items themselves
+        raw = _items(value, raw)
+    if kind == "O":
+        for item in raw.reshape(-1):
+            if isinstance(item, _BOOLS) or not isinstance(item, numbers.Integral):
+                raise TypeError(f"{name} must be {what}, got {item!r} ({type(item).__name__}) "
+                                f"in {value!r}")
+            if not -2 ** 63 <= item < 2 ** 63:
+                raise ValueError(f"{name} holds the index {item!r}, far out of any range")
+    elif kind not in "iu":
+        shown = raw.reshape(-1)[0].item()
+        raise TypeError(f"{name} must be {what}, got {shown!r} ({type(shown).__name__}) "
+                        f"in {value!r}")
+    if kind == "u" and raw.size and int(raw.max()) >= 2 ** 63:
+        raise ValueError(f"{name} holds the index {int(raw.max())!r}, far out of any range")
+    return np.array(raw, dtype=np.int64)
+
+
+def step_count(name, value, minimum=0):
+    """An int step count in ``[minimum, MAX_STEPS]``; bools, floats and text are refused."""
+    if isinstance(value, _BOOLS) or not isinstance(value, numbers.Integral):
+        raise ValueError(f"{name} must be an int >= {minimum}, got {value!r} "
+                         f"({type(value).__name__})")
+    value = int(value)
+    if value < minimum:
+        raise ValueError(f"{name} must be an int >= {minimum}, got {value!r}")
+    if value > MAX_STEPS:
+        raise ValueError(f"{name} must be at most 2**62 = {MAX_STEPS} steps per call, got {value!r}")
+    return value
+
+
 def vector(name, value, dim=None):
     """A finite float vector of length ``dim`` (2 or 3 when ``dim`` is None)."""
-    try:
-        arr = np.array(value, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise TypeError(f"{name} must be a vector of numbers, got {value!r}") from None
+    arr = real_array(name, value, "a vector of numbers")
     if arr.ndim != 1:
         raise ValueError(f"{name} must be a 1-D vector, got shape {arr.shape} ({value!r})")
     allowed = (2, 3) if dim is None else (dim,)
@@ -51,10 +160,7 @@ def vector(name, value, dim=None):
 
 def per_item(name, value, count, *, minimum=None, strictly=False):
     """Broadcast a scalar or length-``count`` array of finite floats, checking a lower bound."""
-    try:
-        arr = np.array(value, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise TypeError(f"{name} must be a number or an array of numbers, got {value!r}") from None
+    arr = real_array(name, value, "a number or an array of numbers")
     if arr.ndim == 0:
         arr = np.full(count, float(arr))
     elif arr.shape != (count,):

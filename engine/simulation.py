@@ -10,14 +10,14 @@ import numpy as np
 
 from . import diagnostics
 from . import integrators as _integrators
-from ._validate import finite_float, nonnegative_float, positive_float
+from ._validate import MAX_STEPS, finite_float, nonnegative_float, positive_float, real_array, step_count
 from .errors import SimulationError
 from .forces.base import Force
 from .forces.dispatch import pack, potential_terms
 from .particles import Particles
 from .units import UnitSystem, strip_without_units
 
-_MAX_STEPS = 2 ** 62
+_MAX_STEPS = MAX_STEPS
 
 
 class Simulation:
@@ -31,7 +31,12 @@ class Simulation:
     tolerance : error tolerance of ``rk45`` (relative and absolute), > 0
     units : ``None`` (code units, G = 1) or three astropy units of length, time and mass
     G : override the gravitational constant (default 1, or astropy's G in ``units``)
-    capacity : initial room for particles (grows as needed)
+    capacity : initial room for particles (an int >= 0; grows as needed)
+
+    ``pos``, ``vel``, ``mass``, ``charge`` and ``radius`` are writable views of the state. A
+    step first checks them: a non-finite value written there (or a negative mass or radius)
+    raises ValueError naming the field and particle, and nothing is changed. Step counts are
+    ints in ``[0, 2**62]``; a step that would take ``t`` past the largest float is refused.
     """
 
     def __init__(self, dim=2, integrator="symplectic_euler", dt=1.0, tolerance=1e-9,
@@ -46,8 +51,12 @@ class Simulation:
             self._G = self._units.G if self._units is not None else 1.0
         else:
             self._G = nonnegative_float("G", G)
+        if isinstance(capacity, (bool, np.bool_)) or not isinstance(capacity, numbers.Integral):
+            raise TypeError(f"capacity must be an int >= 0, got {capacity!r}")
+        if capacity < 0:
+            raise ValueError(f"capacity must be an int >= 0, got {capacity!r}")
         self.dim = int(dim)
-        self._particles = Particles(self.dim, capacity)
+        self._particles = Particles(self.dim, int(capacity))
         self._forces = []
         self._model = None
         self._model_key = None
@@ -176,16 +185,16 @@ class Simulation:
         m = self._column("mass", mass, k, minimum=0.0, single=_single)
         q = self._column("charge", charge, k, single=_single)
         r = self._column("radius", radius, k, minimum=0.0, single=_single)
-        tst = np.broadcast_to(np.asarray(test), (k,))
+        try:
+            tst = np.broadcast_to(np.asarray(test), (k,))
+        except ValueError:
+            raise ValueError(f"test must be True or False (or one per particle), got {test!r}") from None
         if tst.dtype != np.bool_:
             raise TypeError(f"test must be True or False, got {test!r}")
         return self._particles.append(p, v, m, q, r, tst)
 
     def _rows(self, field, value, single):
-        try:
-            arr = np.array(value, dtype=np.float64)
-        except (TypeError, ValueError):
-            raise TypeError(f"{field} must be numbers, got {value!r}") from None
+        arr = real_array(field, value, "numbers")
         shown = value[0] if single else value
         if arr.ndim != 2 or arr.shape[1] != self.dim:
             got = arr.shape[-1] if arr.ndim >= 1 else "a scalar"
@@ -196,10 +205,7 @@ class Simulation:
         return arr
 
     def _column(self, field, value, k, minimum=None, single=False):
-        try:
-            arr = np.array(value, dtype=np.float64)
-        except (TypeError, ValueError):
-            raise TypeError(f"{field} must be a number, got {value!r}") from None
+        arr = real_array(field, value, "a number")
         arr = np.broadcast_to(arr, (k,)) if arr.ndim <= 1 else arr
         if arr.shape != (k,):
             raise ValueError(f"{field} must be a scalar or have length {k}, got shape {arr.shape}")
@@ -261,23 +267,34 @@ class Simulation:
 
     # -- time ------------------------------------------------------------------------
     def step(self, n=1):
-        """Advance ``n`` steps in one compiled call (``n`` accepted steps for rk45)."""
-        if isinstance(n, bool) or not isinstance(n, numbers.Integral) or n < 0:
-            raise ValueError(f"n must be an int >= 0, got {n!r}")
+        """Advance ``n`` steps in one compiled call (``n`` accepted steps for rk45).
+
+        ``n`` is an int in ``[0, 2**62]`` (bools and floats are refused).
+        """
+        n = step_count("n", n)
         if n:
-            self._run(self._dt, int(n), math.nan)
+            self._run(self._dt, n, math.nan)
 
     def integrate(self, t_end):
         """Advance to exactly ``t_end`` (forwards or backwards).
 
         Fixed-step methods take whole steps of |dt| towards ``t_end`` and one shorter last
         step; rk45 shortens its last adaptive step. ``sim.t == t_end`` afterwards.
+        ``t_end`` must be finite and (fixed-step methods) reachable in at most 2**62 steps.
         """
         t_end = finite_float("t_end", self._code(t_end, "time", "t_end"))
         remaining = t_end - self._t
         if remaining == 0.0:
             return
+        if not math.isfinite(remaining):
+            raise ValueError(f"t_end={t_end!r} is too far from t={self._t!r}: the interval "
+                             "overflows a float")
         h = math.copysign(abs(self._dt), remaining)
+        needed = abs(remaining) / abs(h)
+        if self._integrator != "rk45" and not needed <= _MAX_STEPS:
+            raise ValueError(f"t_end={t_end!r} needs {needed:.3g} steps of dt={self._dt!r} from "
+                             f"t={self._t!r}, more than the 2**62 one call can take; use a "
+                             "larger dt or a nearer t_end")
         if self._integrator == "rk45":
             self._run(h, _MAX_STEPS, t_end)
             return
@@ -293,8 +310,11 @@ class Simulation:
         self._t = t_end
 
     def _run(self, h, steps, t_end, keep_dt=False):
+        if self._integrator != "rk45" and not math.isfinite(self._t + steps * h):
+            raise ValueError(f"{steps} steps of {h!r} from t={self._t!r} take the time past the "
+                             "largest float (t would not be finite); nothing was changed")
         pos, vel, prm, n, model = self._kernel_state()
-        self._check_state(pos, vel, prm[0], n)
+        self._check_state(pos, vel, prm, n)
         vdep = any(f.velocity_dependent for f in self._forces)
         t, h_next, done, bad = _integrators.advance(
             self._integrator, self._t, h, steps, pos, vel, prm, n, model, vdep, t_end,
@@ -302,7 +322,8 @@ class Simulation:
         failed_step = self.steps + done
         self._t = t
         self.steps += done
-        if self._integrator == "rk45" and not keep_dt and bad < 0:
+        if (self._integrator == "rk45" and not keep_dt and bad < 0
+                and bad != _integrators.common.TIME_OVERFLOW):
             self._dt = h_next
         if bad >= 0:
             raise SimulationError(
@@ -310,21 +331,44 @@ class Simulation:
                 "non-finite position or velocity (singular force, or dt too large for a stiff "
                 "force); the last finite state is kept",
                 step=failed_step, time=t, particle=int(bad))
+        if bad == _integrators.common.TIME_OVERFLOW:
+            raise SimulationError(
+                f"rk45 step {failed_step} from t={t!r} with step {h_next!r} would take the time "
+                "past the largest float (t would not be finite); the last finite state is kept",
+                step=failed_step, time=t, particle=None)
         if bad == _integrators.common.STEP_COLLAPSED:
             raise SimulationError(
                 f"rk45 step size collapsed at step {failed_step}, t={t!r} (tolerance "
                 f"{self._tolerance!r} cannot be met); the last accepted state is kept",
                 step=failed_step, time=t, particle=None)
 
-    def _check_state(self, pos, vel, mass, n):
-        """Refuse to step from a state the user made invalid by writing the arrays directly."""
+    def _check_state(self, pos, vel, prm, n):
+        """Refuse to step from a state the user made invalid by writing the arrays directly.
+
+        ``sim.pos``, ``vel``, ``mass``, ``charge`` and ``radius`` are writable views: a
+        non-finite value written there is bad input of that field (ValueError naming it, state
+        unchanged), never reported as a numerical blow-up of the step.
+        """
         if not (np.isfinite(pos[:, :n]).all() and np.isfinite(vel[:, :n]).all()):
             bad = np.flatnonzero(~(np.isfinite(pos[:, :n]).all(0) & np.isfinite(vel[:, :n]).all(0)))
-            raise ValueError(f"particle {int(bad[0])} has a non-finite pos or vel "
-                             f"(pos={pos[:, bad[0]]}, vel={vel[:, bad[0]]})")
-        if n and (mass[:n] < 0.0).any():
-            i = int(np.flatnonzero(mass[:n] < 0.0)[0])
-            raise ValueError(f"mass of particle {i} must be >= 0, got {mass[i]!r}")
+            i = int(bad[0])
+            field = "pos" if not np.isfinite(pos[:, i]).all() else "vel"
+            raise ValueError(f"particle {i} has a non-finite pos or vel: {field}[{i}] = "
+                             f"{(pos if field == 'pos' else vel)[:, i]} was written with a "
+                             "non-finite value (bad input); nothing was changed")
+        mass, charge, radius = prm[0], prm[1], prm[2]
+        for field, arr, minimum in (("mass", mass, 0.0), ("charge", charge, None),
+                                    ("radius", radius, 0.0)):
+            values = arr[:n]
+            bad = ~np.isfinite(values)
+            if minimum is not None:
+                bad |= values < minimum
+            if bad.any():
+                i = int(np.flatnonzero(bad)[0])
+                rule = "finite" if minimum is None else f"finite and >= {minimum}"
+                raise ValueError(f"{field}[{i}] must be {rule}, got {float(values[i])!r} (written into "
+                                 f"sim.{field} directly: bad input, not a blow-up); nothing was "
+                                 "changed")
 
     # -- diagnostics -----------------------------------------------------------------
     def kinetic_energy(self):

@@ -31,24 +31,25 @@ def bot_seed(seed, seat):
 
 
 class FaultLog:
-    """Counts of each kind of fault of one seat, and the first few messages."""
+    """Counts of each kind of fault of one seat, the first few messages and the last one."""
 
     def __init__(self):
         self.counts = {kind: 0 for kind in FAULT_KINDS}
         self.examples = []
+        self.last = None
 
     def add(self, frame, kind, message):
         self.counts[kind] += 1
+        self.last = {"frame": int(frame), "kind": kind, "message": str(message)[:MAX_MESSAGE]}
         if len(self.examples) < 5:
-            self.examples.append({"frame": int(frame), "kind": kind,
-                                  "message": str(message)[:MAX_MESSAGE]})
+            self.examples.append(self.last)
 
     @property
     def total(self):
         return sum(self.counts.values())
 
     def to_dict(self):
-        return {"total": self.total, **self.counts, "examples": self.examples}
+        return {"total": self.total, **self.counts, "examples": self.examples, "last": self.last}
 
 
 def play_match(p1, p2, seed=0, rounds=5, rules=None, budget=DEFAULT_BUDGET,

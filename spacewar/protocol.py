@@ -201,8 +201,9 @@ def _ship_vector(ship, rules):
             float(np.sign(ship.charge)), ship.flip_cooldown / max(rules.flip_cooldown, 1)]
 
 
-def observation_from_raw(raw, rules):
-    """The ``Observation`` a raw array describes (arrays in it are read-only copies)."""
+def observation_from_raw(raw, rules, shown_rules=None):
+    """The ``Observation`` a raw array describes (arrays in it are read-only copies).
+    ``rules`` decode it; ``shown_rules`` (default ``rules``) is what ``obs.rules`` holds."""
     raw = np.asarray(raw, dtype=np.float64)
     if raw.shape != (raw_length(rules),):
         raise ValueError(f"raw observation must have shape ({raw_length(rules)},), got {raw.shape}")
@@ -226,4 +227,4 @@ def observation_from_raw(raw, rules):
                        star_pos=_frozen(h[8:10].copy()), star_mu=float(h[6]),
                        star_capture=float(h[7]), frame=int(h[0]), round_frame=int(h[1]),
                        round=int(h[2]), score=(int(h[3]), int(h[4])), seat=int(h[5]),
-                       rules=rules, _vector=vector)
+                       rules=rules if shown_rules is None else shown_rules, _vector=vector)

@@ -24,10 +24,11 @@ when something is drawn.
 import math
 import os
 import random
-import tempfile
 from itertools import product
 
 import numpy as np
+
+from engine.atomic import atomic_write, check_output_path
 
 VIZ_HINT = "pip install -e '.[viz]'"
 
@@ -551,12 +552,6 @@ class _Enough(Exception):
     """Raised inside the replay callback once ``max_frames`` frames are drawn."""
 
 
-def _umask():
-    mask = os.umask(0o022)
-    os.umask(mask)
-    return mask
-
-
 def _check_size(size):
     if isinstance(size, bool) or not isinstance(size, int) or size < 64:
         raise ValueError(f"size must be an int >= 64 (pixels), got {size!r}")
@@ -569,9 +564,11 @@ def render_gif(replay, out_path, every=2, size=480, fps=30, max_frames=None):
     ``replay``: a replay dict or the path of a replay file. Every ``every``-th game frame is
     drawn (and the last one); the GIF plays ``fps`` of those a second (30 with ``every=2``
     shows the game at 60 frames a second, about the original's pace) and holds the final
-    frame a moment. ``max_frames`` stops after that many drawn frames. The file is written to
-    a temporary file beside ``out_path`` and moved into place at the end, so a crash or an
-    interrupt never leaves a partial GIF there.
+    frame a moment. ``max_frames`` stops after that many drawn frames. ``out_path`` is checked
+    first (``engine.atomic.check_output_path(out_path, "gif")``: a missing directory, or an
+    existing file that is not a GIF, such as the replay itself, is refused before anything is
+    drawn); the file is written by ``engine.atomic.atomic_write`` (a temporary file beside it,
+    moved into place at the end), so a crash or an interrupt never leaves a partial GIF there.
     """
     if isinstance(every, bool) or not isinstance(every, int) or every < 1:
         raise ValueError(f"every must be an int >= 1, got {every!r}")
@@ -583,6 +580,7 @@ def render_gif(replay, out_path, every=2, size=480, fps=30, max_frames=None):
                                    or max_frames < 1):
         raise ValueError(f"max_frames must be None or an int >= 1, got {max_frames!r}")
     require_pillow()
+    out_path = check_output_path(out_path, "gif")  # before any work: never over a replay
     from .replay import load, simulate
 
     if isinstance(replay, (str, bytes, os.PathLike)):
@@ -590,36 +588,29 @@ def render_gif(replay, out_path, every=2, size=480, fps=30, max_frames=None):
     names = tuple(replay.get("bots") or DEFAULT_NAMES)
     rounds = replay.get("rounds")
     effects = Effects()
-    out_path = os.fspath(out_path)
-    directory = os.path.dirname(os.path.abspath(out_path))
-    fd, tmp = tempfile.mkstemp(prefix=".render-", suffix=".gif.tmp", dir=directory)
     last = {"frame": 0}
-    try:
-        with os.fdopen(fd, "wb") as f:
-            writer = _GifWriter(f, fps)
+    state = {}
 
-            def on_frame(game):
-                snap = game.snapshot(0)
-                effects.update(snap)
-                last["frame"] = snap["frame"]
-                if snap["frame"] % every == 0 or snap["over"]:
-                    writer.add(render_frame(snap, size, effects=effects, names=names, rounds=rounds))
-                    if max_frames is not None and writer.added >= max_frames:
-                        raise _Enough
+    def draw(f):
+        writer = state["writer"] = _GifWriter(f, fps)
 
-            try:
-                simulate(replay, on_frame)
-            except _Enough:
-                pass
-            writer.close()
-            f.flush()
-            os.fsync(f.fileno())
-        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; give the usual file mode
-        os.replace(tmp, out_path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+        def on_frame(game):
+            snap = game.snapshot(0)
+            effects.update(snap)
+            last["frame"] = snap["frame"]
+            if snap["frame"] % every == 0 or snap["over"]:
+                writer.add(render_frame(snap, size, effects=effects, names=names, rounds=rounds))
+                if max_frames is not None and writer.added >= max_frames:
+                    raise _Enough
+
+        try:
+            simulate(replay, on_frame)
+        except _Enough:
+            pass
+        writer.close()
+
+    atomic_write(out_path, draw, "wb")  # never a partial GIF at out_path; mode 0o666 & ~umask
+    writer = state["writer"]
     return {"path": out_path, "frames": writer.written, "drawn": writer.added,
             "game_frames": last["frame"], "size": size, "bytes": os.path.getsize(out_path)}
 

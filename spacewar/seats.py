@@ -115,6 +115,7 @@ class InlineSeat:
             raise ValueError(f"inline seats are for built-in bots only, got {spec!r}: "
                              "other bots run in their own process")
         self.spec = spec
+        self._rules = rules
         self.rules = type(rules).from_dict(rules.to_dict())  # the bot may break only its own copy
         self.bot = make_bot(spec, seed=seed) if bot is None else bot
         self.bank = _Bank(limits)
@@ -126,7 +127,7 @@ class InlineSeat:
 
     def act(self, raw):
         """``(code, fault)``: fault is None or ``(kind, message)``."""
-        obs = observation_from_raw(raw, self.rules)
+        obs = observation_from_raw(raw, self._rules, self.rules)
         start = time.perf_counter()
         try:
             result = self.bot.act(obs)
@@ -164,6 +165,8 @@ def _bot_environment(scratch):
     for key in ("OPENBLAS_CORETYPE", "OPENBLAS_L2_SIZE"):  # keep numpy working on this CPU
         if key in os.environ:
             env[key] = os.environ[key]
+    if "SPACEWAR_BOT_TAG" in os.environ:  # lets a caller find its bots' processes (tests do)
+        env["SPACEWAR_BOT"] = os.environ["SPACEWAR_BOT_TAG"]
     return env
 
 

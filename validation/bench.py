@@ -28,6 +28,8 @@ import time
 
 import numpy as np
 
+from engine.atomic import OutputPathError, atomic_write, check_output_path
+
 SOLAR_MASS = 4.0 * math.pi ** 2
 DAYS_PER_YEAR = 365.24
 # The Benchmarks Game n-body initial conditions (Sun, Jupiter, Saturn, Uranus, Neptune), in
@@ -622,16 +624,24 @@ def main(argv=None):
     parser.add_argument("--only", metavar="SECTIONS",
                         help="comma-separated: direct,small,scaling,terms,startup,spacewar")
     args = parser.parse_args(argv)
+    # a bad output path fails now, not after minutes of benchmarks
+    try:
+        for path, kind in ((args.json, "json"), (args.markdown, "markdown")):
+            if path is not None:
+                check_output_path(path, kind)
+    except OutputPathError as exc:
+        parser.error(str(exc))
+    if args.json is not None and args.markdown is not None and \
+            os.path.abspath(args.json) == os.path.abspath(args.markdown):
+        parser.error(f"--json and --markdown name the same file {args.json!r}")
     sections = args.only.split(",") if args.only else None
     report = run(quick=args.quick, sections=sections)
     print(format_report(report))
     if args.json:
-        with open(args.json, "w") as f:
-            json.dump(report, f, indent=2, sort_keys=True)
+        atomic_write(args.json, json.dumps(report, indent=2, sort_keys=True))
     if args.markdown:
         command = "python -m validation bench" + (" --quick" if args.quick else "")
-        with open(args.markdown, "w") as f:
-            f.write(format_markdown(report, command))
+        atomic_write(args.markdown, format_markdown(report, command))
     return 0
 
 

@@ -7,6 +7,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from engine.atomic import atomic_write  # noqa: E402
+
 STYLE = {
     "engine:euler": ("tab:red", "-", "o"),
     "engine:symplectic_euler": ("tab:orange", "-", "v"),
@@ -33,8 +35,12 @@ def _style(method):
 
 
 def _save(fig, path):
-    fig.savefig(path, dpi=110, bbox_inches="tight")
-    plt.close(fig)
+    """Write the figure as a PNG atomically (never a truncated plot at ``path``)."""
+    try:
+        atomic_write(path, lambda f: fig.savefig(f, format="png", dpi=110, bbox_inches="tight"),
+                     "wb")
+    finally:
+        plt.close(fig)
 
 
 def _grid(n, width=4.6, height=3.6, cols=3):

@@ -18,6 +18,7 @@ import time
 import numpy as np
 
 import engine
+from engine.atomic import OutputPathError, atomic_write, check_output_dir, check_output_path
 
 from . import drift, hardcases, plots, sweeps, twobody
 from .jobs import Job, run_jobs
@@ -880,11 +881,29 @@ def write(out_dir, res, level):
     if "hard_cases" in res:
         plots.spring_limits(res["hard_cases"]["spring_limits"],
                             os.path.join(out_dir, "spring_limits.png"))
-    with open(os.path.join(out_dir, "results.json"), "w") as fh:
-        json.dump(jsonable(res), fh, indent=1)
-        fh.write("\n")
-    with open(os.path.join(out_dir, "report.md"), "w") as fh:
-        fh.write(markdown(res, level, figs))
+    atomic_write(os.path.join(out_dir, "results.json"), json.dumps(jsonable(res), indent=1) + "\n")
+    atomic_write(os.path.join(out_dir, "report.md"), markdown(res, level, figs))
+
+
+def output_files(sections=SECTIONS):
+    """The files ``write`` produces in the output directory, with their kinds."""
+    files = {"report.md": "markdown", "results.json": "json"}
+    if "two_body" in sections:
+        files["two_body_convergence.png"] = "png"
+        files["two_body_growth.png"] = "png"
+    if "energy_drift" in sections:
+        files["energy_drift.png"] = "png"
+    if "hard_cases" in sections:
+        files["spring_limits.png"] = "png"
+    return files
+
+
+def check_outputs(out_dir, sections=SECTIONS):
+    """Raise OutputPathError now if the report could not be written to ``out_dir`` later."""
+    check_output_dir(out_dir)
+    if os.path.isdir(out_dir):
+        for name, kind in output_files(sections=sections).items():
+            check_output_path(os.path.join(out_dir, name), kind)
 
 
 def markdown(res, level, figs):
@@ -943,6 +962,10 @@ def main(argv=None):
     if unknown:
         parser.error(f"unknown section(s) {', '.join(sorted(unknown))}; "
                      f"choose from {', '.join(SECTIONS)}")
+    try:
+        check_outputs(args.out, sections)  # fail now, not after the runs
+    except (OutputPathError, TypeError) as exc:
+        parser.error(str(exc))
     res = collect(level, workers=max(1, args.workers), progress=not args.no_progress,
                   sections=sections)
     write(args.out, res, level)

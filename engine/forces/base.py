@@ -36,6 +36,13 @@ class Force:
     assigning one raises AttributeError (an unchecked index array must never reach compiled
     code, and a silently ignored assignment would be worse). Properties with setters
     (``point_mass.pos = ...``) work as they define.
+
+    Public array attributes (spring ``pairs``, wind ``triangles``, ``PointMass.particles``,
+    per-spring ``k`` ...) are stored as read-only views (``writeable=False``): writing an index
+    in place would reach the compiled kernels unchecked (an out-of-range index there reads or
+    writes outside the particle arrays), and a changed value would be silently ignored by an
+    already packed model. Every term is also re-checked (``_check``) whenever a simulation
+    packs its model.
     """
 
     KIND = -1
@@ -81,6 +88,7 @@ class Force:
         if name.startswith("_") or isinstance(getattr(type(self), name, None), property):
             object.__setattr__(self, name, value)
             return
+        value = _read_only(value)
         check = self._settable.get(name)
         if check is None:
             if self.__dict__.get("_sealed", False):
@@ -106,6 +114,14 @@ class Force:
         return f"{type(self).__name__}()"
 
 
+def _read_only(value):
+    """A read-only view of an array (the caller's own array keeps its flags)."""
+    if isinstance(value, np.ndarray):
+        value = value.view()
+        value.flags.writeable = False
+    return value
+
+
 def floats(*values):
     return np.array(values, dtype=np.float64)
 
@@ -116,3 +132,5 @@ def ints(*values):
 
 EMPTY_INTS = np.zeros(0, dtype=np.int64)
 EMPTY_FLOATS = np.zeros(0, dtype=np.float64)
+EMPTY_INTS.flags.writeable = False
+EMPTY_FLOATS.flags.writeable = False

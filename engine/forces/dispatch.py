@@ -89,8 +89,14 @@ def potential_terms(t, pos, vel, mass, charge, radius, active, test, n, kinds, f
 
 
 def pack(terms, sim):
-    """Concatenate the terms' parameters into the model tuple the kernels take."""
+    """Concatenate the terms' parameters into the model tuple the kernels take.
+
+    Every term is re-checked against ``sim`` first (indices in range, dimension), so nothing
+    changed since it was added can reach the kernels unchecked.
+    """
     fps, ips = [], []
+    for term in terms:
+        term._check(sim)
     for term in terms:
         fp, ip = term._pack(sim)
         fps.append(np.ascontiguousarray(fp, dtype=np.float64))

@@ -11,7 +11,7 @@ import math
 from numba import njit
 
 from .base import Force, EMPTY_INTS
-from .._validate import positive_float, nonnegative_float, vector
+from .._validate import index_array, positive_float, nonnegative_float, vector
 
 import numpy as np
 
@@ -85,10 +85,7 @@ class PointMass(Force):
         if particles is None:
             self.particles = EMPTY_INTS
         else:
-            try:
-                self.particles = np.array(particles, dtype=np.int64).reshape(-1)
-            except (TypeError, ValueError, OverflowError):
-                raise TypeError(f"particles must be particle indices, got {particles!r}") from None
+            self.particles = index_array("particles", particles).reshape(-1)
             if self.particles.size == 0:
                 raise ValueError("particles must list at least one index (None means all)")
 

@@ -18,7 +18,7 @@ from numba import njit
 
 from ._kernels import add_force, delta
 from .base import Force
-from .._validate import per_item, vector, positive_float, nonnegative_float
+from .._validate import index_array, per_item, vector, positive_float, nonnegative_float
 
 KIND = 4
 
@@ -66,7 +66,9 @@ def potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip
 class Springs(Force):
     """Springs between index ``pairs``; ``k``, ``rest_length``, ``damping`` scalar or per spring.
 
-    The indices are checked against the simulation when the term is added.
+    The indices are checked against the simulation when the term is added (and again whenever
+    the simulation packs its model). ``pairs``, ``k``, ``rest_length`` and ``damping`` are
+    read-only arrays: an index written in place would reach the compiled kernels unchecked.
     """
 
     KIND = KIND
@@ -74,12 +76,7 @@ class Springs(Force):
 
     def __init__(self, pairs, k=10.0, rest_length=1.0, damping=0.0):
         super().__init__()
-        try:
-            arr = np.array(pairs, dtype=np.int64)
-        except (TypeError, ValueError, OverflowError):
-            raise TypeError(f"pairs must be a list of (i, j) index pairs, got {pairs!r}") from None
-        if arr.size == 0:
-            arr = arr.reshape(0, 2)
+        arr = index_array("pairs", pairs, 2)
         if arr.ndim != 2 or arr.shape[1] != 2:
             raise ValueError(f"pairs must have shape (M, 2), got shape {arr.shape}")
         if np.any(arr[:, 0] == arr[:, 1]):

@@ -14,7 +14,7 @@ from numba import njit
 
 from ._kernels import add_force
 from .base import Force
-from .._validate import vector
+from .._validate import index_array, vector
 
 KIND = 7
 
@@ -53,19 +53,17 @@ def potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip
 
 
 class Wind(Force):
-    """Wind pressure ``w`` (3-vector) on ``triangles`` (M x 3 particle indices); 3-D only."""
+    """Wind pressure ``w`` (3-vector) on ``triangles`` (M x 3 particle indices); 3-D only.
+
+    ``triangles`` is a read-only array (checked when the term is added and when packed).
+    """
 
     KIND = KIND
 
     def __init__(self, w, triangles):
         super().__init__()
         self._w = vector("w", w, 3)
-        try:
-            tri = np.array(triangles, dtype=np.int64)
-        except (TypeError, ValueError, OverflowError):
-            raise TypeError(f"triangles must be (M, 3) particle indices, got {triangles!r}") from None
-        if tri.size == 0:
-            tri = tri.reshape(0, 3)
+        tri = index_array("triangles", triangles, 3)
         if tri.ndim != 2 or tri.shape[1] != 3:
             raise ValueError(f"triangles must have shape (M, 3), got shape {tri.shape}")
         self.triangles = tri

@@ -4,7 +4,8 @@ Every integrator module exposes ``advance(t, h, steps, pos, vel, prm, n, model, 
 returning ``(t, h_next, done, bad)``: the new time, the step to use next (``h`` for fixed-step
 methods), the number of steps completed, and ``bad`` = -1 on success, the index of the first
 non-finite particle when a step blew up (the state is then the last finite one and ``done`` is
-the index of the failing step), or -2 when an adaptive step size collapsed. ``t_end`` is only
+the index of the failing step), or -2 when an adaptive step size collapsed, or -3 when an adaptive step would make the
+time non-finite (the state is then the last accepted one). ``t_end`` is only
 used by adaptive methods (they shorten their last step to land on it; NaN means no target).
 """
 import math
@@ -14,6 +15,8 @@ from numba import njit
 
 OK = -1
 STEP_COLLAPSED = -2
+#: an adaptive step would take the time past the largest float (the state is kept)
+TIME_OVERFLOW = -3
 
 
 @njit(cache=True, error_model="numpy", inline="always")

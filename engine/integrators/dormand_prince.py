@@ -17,7 +17,7 @@ import numpy as np
 from numba import njit
 
 from ..forces.dispatch import accelerations
-from .common import OK, STEP_COLLAPSED, first_nonfinite, first_nonfinite_array
+from .common import OK, STEP_COLLAPSED, TIME_OVERFLOW, first_nonfinite, first_nonfinite_array
 
 NAME = "rk45"
 ORDER = 5
@@ -98,6 +98,8 @@ def advance(t, h, steps, pos, vel, mass, charge, radius, active, test, n, kinds,
             if abs(h) >= abs(remaining):
                 h_try = remaining
                 last = True
+        if not math.isfinite(t + h_try):
+            return t, h, done, TIME_OVERFLOW
         for s in range(1, 7):
             _stage_state(pos, vel, kx, kv, s, h_try, n, sx, sv)
             kx[s, :, :] = sv

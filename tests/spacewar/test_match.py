@@ -8,6 +8,7 @@ import pytest
 from spacewar import replay
 from spacewar.bots import BotLoadError, available, load_bot_class
 from spacewar.match import play_match
+from spacewar.seats import Limits
 
 HERE = os.path.dirname(__file__)
 TEST_BOTS = "tests.spacewar.bots_for_tests"
@@ -66,11 +67,16 @@ def test_unknown_bot_in_a_match_lists_the_available():
                                        ("Slow", "timeout")])
 @pytest.mark.parametrize("isolation", ["inline", "process"])
 def test_faulty_bot_loses_turns_is_reported_and_forfeits(bot, kind, isolation):
-    result, _, _ = play_match(f"{TEST_BOTS}:{bot}", "chaser", seed=1, rounds=1, budget=0.01,
-                              max_faults=6, isolation=isolation)
+    from tests.spacewar import bots_for_tests
+
+    # inline: a bot object of the caller's own; process: the same class named by a string
+    spec = getattr(bots_for_tests, bot)() if isolation == "inline" else f"{TEST_BOTS}:{bot}"
+    result, _, _ = play_match(spec, "chaser", seed=1, rounds=1,
+                              limits=Limits(budget=0.01, overage=0.0), max_faults=6)
     faults = result["faults"][0]
     assert faults[kind] == 6 and faults["total"] == 6
-    assert result["forfeit"] == f"{TEST_BOTS}:{bot}" and result["winner"] == "chaser"
+    name = f"tests.spacewar.bots_for_tests.{bot}" if isolation == "inline" else f"{TEST_BOTS}:{bot}"
+    assert result["forfeit"] == name and result["winner"] == "chaser"
     assert faults["examples"][0]["kind"] == kind and faults["examples"][0]["message"]
     assert result["faults"][1]["total"] == 0
 
@@ -118,7 +124,7 @@ def test_tampered_replay_fails_the_check(tmp_path):
 
 def test_replay_of_a_forfeited_match_checks(tmp_path):
     result, rep, _ = play_match(f"{TEST_BOTS}:Raising", "chaser", seed=1, rounds=1,
-                                max_faults=3, isolation="inline", record=True)
+                                max_faults=3, record=True)
     assert result["forfeit"] and replay.check(rep)[0]
 
 

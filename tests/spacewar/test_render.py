@@ -109,7 +109,7 @@ def test_every_and_max_frames_and_a_replay_file(tmp_path, replay):
 
 def test_a_crash_mid_render_leaves_no_partial_file(tmp_path, replay, monkeypatch):
     out = tmp_path / "keep.gif"
-    out.write_bytes(b"the previous file")
+    out.write_bytes(b"GIF89a the previous file")  # a GIF may be replaced by a new GIF
     calls = {"n": 0}
     real = render.render_frame
 
@@ -122,7 +122,7 @@ def test_a_crash_mid_render_leaves_no_partial_file(tmp_path, replay, monkeypatch
     monkeypatch.setattr(render, "render_frame", failing)
     with pytest.raises(RuntimeError, match="boom"):
         render_gif(replay, out, size=SIZE)
-    assert out.read_bytes() == b"the previous file"
+    assert out.read_bytes() == b"GIF89a the previous file"
     assert os.listdir(tmp_path) == ["keep.gif"]
 
 

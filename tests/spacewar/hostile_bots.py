@@ -1,0 +1,339 @@
+"""Bots written to attack the match, the tournament and the machine (tests/spacewar/
+test_untrusted_bots.py plays each). Every one of them would change a result, crash or hang
+the match, leak a process or read a secret if the sandbox let it."""
+import gc
+import os
+import struct
+import sys
+import time
+
+from spacewar import NOOP, Action
+
+
+class DoNothing:
+    """The honest baseline: plays the no-op every frame."""
+
+    def act(self, obs):
+        return NOOP
+
+
+# -- cheating ---------------------------------------------------------------------------------
+class _Payload:
+    """Unpickling this runs code in the unpickler: it would kill the enemy ship."""
+
+    def __reduce__(self):
+        return (exec, ("import gc\nfor o in gc.get_objects():\n"
+                       "    if type(o).__name__ == 'Game': o.ship_i[:, 1, 7] = 0",))
+
+
+class _EvilAction(Action):
+    def code(self):
+        return _Payload()
+
+
+class PickleBomb:
+    """Answers with an Action whose ``code()`` is a pickle payload."""
+
+    def act(self, obs):
+        return _EvilAction()
+
+
+class ReducePayload:
+    """Answers with the payload itself."""
+
+    def act(self, obs):
+        return _Payload()
+
+
+class GcKiller:
+    """Looks for the Game through the garbage collector and kills the enemy ship."""
+
+    def act(self, obs):
+        for o in gc.get_objects():
+            if type(o).__name__ == "Game":
+                o.ship_i[:, 1 - obs.seat, 7] = 0
+        return NOOP
+
+
+class ForgedTurn:
+    """An Action with turn=100 forced past the dataclass's check."""
+
+    def act(self, obs):
+        a = Action()
+        object.__setattr__(a, "turn", 100)
+        return a
+
+
+class HugeCode:
+    """An Action subclass whose code() is 10**30, then a string."""
+
+    def act(self, obs):
+        class Big(Action):
+            def code(self):
+                return 10 ** 30 if obs.frame % 2 else "fire"
+        return Big()
+
+
+class RaisingRepr:
+    """Returns an object whose repr raises (used to crash the fault message)."""
+
+    def act(self, obs):
+        class Bad:
+            def __repr__(self):
+                raise RuntimeError("repr bomb")
+        return Bad()
+
+
+# -- the wire ---------------------------------------------------------------------------------
+def _answer_fd():
+    return int(sys.argv[-1])
+
+
+class RawBytes:
+    """Writes garbage straight into its answer pipe."""
+
+    def act(self, obs):
+        os.write(_answer_fd(), b"\x80\x03garbage" * 100)
+        return NOOP
+
+
+class ForgedOk:
+    """Writes a well-formed answer for a frame it was not asked (4242), code 5."""
+
+    def act(self, obs):
+        os.write(_answer_fd(), struct.pack("<4sqBBH", b"SWA1", 4242, 1, 5, 0))
+        return NOOP
+
+
+class ForgedCode:
+    """Writes its own answer with an out-of-range code for the right frame, then stays
+    silent (its host's answer is swallowed by exiting)."""
+
+    def act(self, obs):
+        os.write(_answer_fd(), struct.pack("<4sqBBH", b"SWA1", obs.frame, 1, 200, 0))
+        if obs.frame > 3:
+            os._exit(0)
+        return NOOP
+
+
+class HugeText:
+    """Claims a 60 kB error text, sends half of it, then goes quiet."""
+
+    def act(self, obs):
+        os.write(_answer_fd(), struct.pack("<4sqBBH", b"SWA1", obs.frame, 2, 0, 60000) + b"x" * 100)
+        time.sleep(60)
+
+
+class ShrinkPipe:
+    """Shrinks its observation pipe to one page, then reads nothing more."""
+
+    def act(self, obs):
+        import fcntl
+        fcntl.fcntl(int(sys.argv[-2]), 1031, 4096)  # F_SETPIPE_SZ
+        time.sleep(60)
+
+
+# -- hanging and start-up ----------------------------------------------------------------------
+class EndlessLoop:
+    def act(self, obs):
+        while True:
+            pass
+
+
+class SlowInit:
+    def __init__(self):
+        time.sleep(35)
+
+    def act(self, obs):
+        return NOOP
+
+
+class LoopInReset:
+    def reset(self):
+        while True:
+            pass
+
+    def act(self, obs):
+        return NOOP
+
+
+class RaiseInInit:
+    def __init__(self):
+        raise RuntimeError("no init for you")
+
+    def act(self, obs):
+        return NOOP
+
+
+class RaiseInReset:
+    def reset(self):
+        raise RuntimeError("no reset for you")
+
+    def act(self, obs):
+        return NOOP
+
+
+class ExitInAct:
+    """sys.exit and KeyboardInterrupt from act: faults, the process serves on."""
+
+    def act(self, obs):
+        if obs.frame % 2:
+            sys.exit(3)
+        raise KeyboardInterrupt
+
+
+# -- processes --------------------------------------------------------------------------------
+class Forker:
+    """Starts a detached child that would outlive the match, forks, and keeps trying."""
+
+    def reset(self):
+        self.errors = []
+        for attempt in (self._popen, self._fork):
+            try:
+                attempt()
+            except Exception as exc:
+                self.errors.append(type(exc).__name__)
+        print("forker:", self.errors, flush=True)
+
+    def _popen(self):
+        import subprocess
+        subprocess.Popen(["sleep", "1000"], start_new_session=True)
+
+    def _fork(self):
+        if os.fork() == 0:
+            while True:
+                pass
+
+    def act(self, obs):
+        try:
+            self._fork()
+        except Exception:
+            pass
+        return NOOP
+
+
+class Spinner:
+    """Works hard in act (for the test that kills the match process mid-match)."""
+
+    def act(self, obs):
+        end = time.perf_counter() + 0.002
+        while time.perf_counter() < end:
+            pass
+        return NOOP
+
+
+class Threads:
+    def act(self, obs):
+        import threading
+        threading.Thread(target=time.sleep, args=(100,)).start()
+        return NOOP
+
+
+# -- resources --------------------------------------------------------------------------------
+class MemoryHog:
+    def act(self, obs):
+        self.block = bytearray(8 << 30)
+        return NOOP
+
+
+class Printer:
+    """Prints megabytes, and a fake match result, to its stdout and stderr."""
+
+    def reset(self):
+        print('{"winner": "hostile", "winner_seat": 0, "score": [9, 0]}', flush=True)
+
+    def act(self, obs):
+        sys.stdout.write("spam " * 20000 + "\n")
+        sys.stderr.write("more " * 20000 + "\n")
+        os.write(1, b"raw " * 10000)
+        return NOOP
+
+
+class DiskFiller:
+    """Writes files in its scratch directory until something stops it."""
+
+    def reset(self):
+        written = 0
+        try:
+            for k in range(10000):
+                with open(f"fill{k}.bin", "wb") as f:
+                    f.write(b"\0" * (1 << 20))
+                written += 1
+        except OSError as exc:
+            print(f"filler stopped after {written} MiB: {type(exc).__name__}", flush=True)
+
+    def act(self, obs):
+        return NOOP
+
+
+# -- reading, network -------------------------------------------------------------------------
+class Snooper:
+    """Tries to read the files named in SNOOP_TARGETS (set by the test), /etc/passwd and
+    other processes' command lines, and prints what it gets."""
+
+    TARGETS = ()
+
+    def reset(self):
+        found = {}
+        targets = list(self.TARGETS) + ["/etc/passwd", "/etc/hostname"]
+        for path in targets:
+            try:
+                with open(path) as f:
+                    found[path] = f.read(200)
+            except OSError as exc:
+                found[path] = f"BLOCKED {type(exc).__name__}"
+        try:
+            found["/proc"] = " ".join(p for p in os.listdir("/proc") if p.isdigit())
+        except OSError as exc:
+            found["/proc"] = f"BLOCKED {type(exc).__name__}"
+        print(repr(found), flush=True)
+
+    def act(self, obs):
+        return NOOP
+
+
+class Networker:
+    """Tries TCP to 127.0.0.1 (port in its class attribute), UDP, and a UNIX socket path."""
+
+    PORT = 9
+    UNIX_PATH = "/tmp/none"
+
+    def reset(self):
+        import socket
+        outcome = {}
+        for name, family, kind, address in (
+                ("tcp", socket.AF_INET, socket.SOCK_STREAM, ("127.0.0.1", self.PORT)),
+                ("udp", socket.AF_INET, socket.SOCK_DGRAM, ("127.0.0.1", self.PORT)),
+                ("unix", socket.AF_UNIX, socket.SOCK_STREAM, self.UNIX_PATH)):
+            try:
+                s = socket.socket(family, kind)
+                s.settimeout(1.0)
+                s.connect(address)
+                s.send(b"hello from the bot")
+                outcome[name] = "CONNECTED"
+            except OSError as exc:
+                outcome[name] = f"BLOCKED {type(exc).__name__}"
+        print(repr(outcome), flush=True)
+
+    def act(self, obs):
+        return NOOP
+
+
+class Writer:
+    """Tries to write next to its own source file and into the project."""
+
+    def reset(self):
+        import spacewar
+        outcome = {}
+        for path in (os.path.join(os.path.dirname(os.path.abspath(__file__)), "planted.txt"),
+                     os.path.join(os.path.dirname(spacewar.__file__), "planted.py"), "/tmp/planted"):
+            try:
+                with open(path, "w") as f:
+                    f.write("x")
+                outcome[path] = "WRITTEN"
+            except OSError as exc:
+                outcome[path] = f"BLOCKED {type(exc).__name__}"
+        print(repr(outcome), flush=True)
+
+    def act(self, obs):
+        return NOOP

@@ -1,0 +1,374 @@
+"""Hostile bots against the sandbox: each match and tournament finishes, the fault is named,
+nothing is left running, the JSON is valid and no cheat changes a result.
+
+The bots are in hostile_bots.py; those whose attack is in their module's import, or needs a
+path or port chosen by the test, are written to a temporary file here.
+"""
+import json
+import os
+import signal
+import socket
+import subprocess
+import sys
+import textwrap
+import time
+
+import pytest
+
+from spacewar import Rules
+from spacewar.cli import main
+from spacewar.match import play_match
+from spacewar.seats import Limits
+from spacewar.tournament import run_tournament
+
+HOSTILE = "tests.spacewar.hostile_bots"
+SHORT = Rules(max_round_frames=400, post_round_delay=8)  # a drawn round ends soon
+FAST = Limits(budget=0.05, overage=0.2, startup=10.0, stop_after=0.5)
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"),
+                                reason="the bot sandbox's checks here are Linux's")
+
+
+TAG = f"SPACEWAR_BOT=test-{os.getpid()}".encode()
+
+
+def bot_processes():
+    """Every process started by a bot of this test run, or by what it started: they carry
+    the tag of this run in their environment (``SPACEWAR_BOT_TAG`` here becomes
+    ``SPACEWAR_BOT`` in a bot's environment, and only there)."""
+    found = []
+    for pid in os.listdir("/proc"):
+        if not pid.isdigit():
+            continue
+        try:
+            with open(f"/proc/{pid}/environ", "rb") as f:
+                tagged = TAG in f.read().split(b"\0")
+            with open(f"/proc/{pid}/cmdline", "rb") as f:
+                cmd = f.read().replace(b"\0", b" ").decode(errors="replace")
+        except OSError:
+            continue
+        if tagged:
+            found.append(f"{pid}: {cmd}")
+    return found
+
+
+@pytest.fixture(autouse=True)
+def nothing_left_running(monkeypatch):
+    monkeypatch.setenv("SPACEWAR_BOT_TAG", TAG.decode().split("=", 1)[1])
+    yield
+    deadline = time.monotonic() + 3.0
+    while bot_processes() and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert bot_processes() == []
+
+
+def write_bot(tmp_path, source, name="bot.py"):
+    path = tmp_path / name
+    path.write_text(textwrap.dedent(source))
+    return str(path)
+
+
+def play(p1, p2="sniper", rules=SHORT, limits=FAST, **kw):
+    result, _, _ = play_match(p1, p2, seed=3, rounds=1, rules=rules, limits=limits, **kw)
+    json.dumps(result)  # plain data
+    return result
+
+
+@pytest.fixture(scope="module")
+def baseline():
+    """A do-nothing bot in its own process against sniper: what every cheat must still get."""
+    result, replay, _ = play_match(f"{HOSTILE}:DoNothing", "sniper", seed=3, rounds=1, rules=SHORT, limits=FAST,
+                                   record=True)
+    assert result["winner"] == "sniper" and result["faults"][0]["total"] == 0
+    return result, replay
+
+
+# -- cheats -------------------------------------------------------------------------------------
+@pytest.mark.parametrize("bot", ["PickleBomb", "GcKiller", "HugeCode"])
+def test_cheats_do_not_change_the_result(bot, baseline):
+    """The answer crosses as an action code and nothing else: the pickle payload, a Game
+    found through gc (there is none in the bot's process) and a code() override change
+    nothing. PickleBomb and GcKiller play the no-op, so the match is the baseline's to the bit."""
+    expected, _ = baseline
+    result = play(f"{HOSTILE}:{bot}")
+    assert result["winner"] == "sniper" and result["score"] == expected["score"]
+    if bot != "HugeCode":
+        assert result["steps"] == expected["steps"] and result["faults"][0]["total"] == 0
+
+
+def test_import_time_patch_of_the_match_does_not_rig_a_tournament(tmp_path):
+    rigger = write_bot(tmp_path, """
+        import spacewar.match as m
+        def rigged(game, bots, *args, **kw):
+            return {"winner": bots[0], "score": [9, 0]}
+        m._result = rigged
+        from spacewar import NOOP
+        class Rigger:
+            def act(self, obs):
+                return NOOP
+    """)
+    kw = dict(games=1, seed=2, rounds=1, rules=SHORT, progress=False, limits=FAST)
+    for workers in (1, 2):
+        report, _ = run_tournament([f"{rigger}:Rigger", "sniper"], workers=workers, **kw)
+        rows = {r["bot"]: r for r in report["table"]}
+        assert rows["sniper"]["wins"] == 2 and rows[f"{rigger}:Rigger"]["wins"] == 0
+
+
+def test_exit_at_import_forfeits_and_the_tournament_prints_its_table(tmp_path, capsys):
+    dead = write_bot(tmp_path, """
+        import os
+        os._exit(9)
+        class Dead:
+            def act(self, obs):
+                return None
+    """)
+    args = ["tournament", "--bots", f"{dead}:Dead,idle,sniper", "--games", "1", "--rounds", "1",
+            "--workers", "1", "--no-progress", "--json"]
+    assert main(args) == 0
+    report = json.loads(capsys.readouterr().out)
+    rows = {r["bot"]: r for r in report["table"]}
+    assert rows[f"{dead}:Dead"]["forfeits"] == 4 and rows[f"{dead}:Dead"]["wins"] == 0
+    assert rows["sniper"]["played"] == 4
+
+
+# -- answers that used to crash the match --------------------------------------------------------
+@pytest.mark.parametrize("bot, kind", [("ForgedTurn", "invalid"), ("ReducePayload", "invalid"),
+                                       ("RaisingRepr", "invalid"), ("ExitInAct", "raised")])
+def test_bad_answers_are_faults(bot, kind):
+    result = play(f"{HOSTILE}:{bot}", max_faults=5)
+    f = result["faults"][0]
+    assert f[kind] == 5 and f["total"] == 5 and result["forfeit"] == f"{HOSTILE}:{bot}"
+    assert result["winner"] == "sniper"
+
+
+@pytest.mark.parametrize("bot", ["RawBytes", "ForgedOk", "ForgedCode", "HugeText"])
+def test_protocol_breaches_forfeit_at_once(bot):
+    start = time.monotonic()
+    result = play(f"{HOSTILE}:{bot}", max_faults=1000)
+    assert result["forfeits"] == [True, False] and result["winner"] == "sniper"
+    kinds = [e["kind"] for e in result["faults"][0]["examples"]]
+    assert "invalid" in kinds or "crashed" in kinds or "timeout" in kinds
+    assert time.monotonic() - start < 60
+
+
+# a round that would last 200000 frames, so the match outlasts any wait of the bot's
+LONG = Rules(star="none", max_round_frames=200_000, max_extra_rounds=0)
+
+
+@pytest.mark.parametrize("bot", ["EndlessLoop", "ShrinkPipe"])
+def test_a_bot_that_never_answers_is_stopped_and_forfeits(bot):
+    """Frames go on while it is busy (each one a timeout, the match never waits on it); once
+    it has been silent ``stop_after`` past its allowance it is killed and forfeits, whatever
+    the fault allowance."""
+    start = time.monotonic()
+    result = play(f"{HOSTILE}:{bot}", "idle", rules=LONG, max_faults=10 ** 6)
+    f = result["faults"][0]
+    assert result["forfeits"] == [True, False] and f["timeout"] == f["total"] >= 2
+    assert f["last"]["message"].startswith("stopped: no answer to frame 0")
+    assert time.monotonic() - start < 30
+
+
+@pytest.mark.parametrize("bot", ["SlowInit", "LoopInReset"])
+def test_slow_start_is_a_start_up_fault(bot):
+    start = time.monotonic()
+    result = play(f"{HOSTILE}:{bot}", limits=Limits(startup=1.5))
+    assert result["faults"][0]["startup"] == 1 and result["forfeits"] == [True, False]
+    assert "start-up budget" in result["faults"][0]["examples"][0]["message"]
+    assert time.monotonic() - start < 20
+
+
+@pytest.mark.parametrize("bot", ["RaiseInInit", "RaiseInReset"])
+def test_start_up_errors_forfeit_with_the_message(bot):
+    result = play(f"{HOSTILE}:{bot}")
+    f = result["faults"][0]
+    assert f["startup"] == 1 and "RuntimeError: no" in f["examples"][0]["message"]
+    assert result["winner"] == "sniper" and result["steps"] == 0
+
+
+def test_both_bots_failing_to_start_is_nobody_s_win():
+    result = play(f"{HOSTILE}:RaiseInInit", f"{HOSTILE}:RaiseInReset")
+    assert result["forfeits"] == [True, True] and result["winner"] is None
+
+
+def test_a_tournament_survives_start_up_faults():
+    report, _ = run_tournament([f"{HOSTILE}:RaiseInInit", f"{HOSTILE}:SlowInit", "idle"],
+                               games=1, seed=1, rounds=1, rules=SHORT, workers=2,
+                               progress=False, limits=Limits(startup=1.5))
+    rows = {r["bot"]: r for r in report["table"]}
+    assert rows["idle"]["wins"] == 4
+    assert rows[f"{HOSTILE}:RaiseInInit"]["forfeits"] == 4
+
+
+# -- processes -------------------------------------------------------------------------------------
+@pytest.mark.parametrize("bot", ["Forker", "Threads"])
+def test_bots_cannot_start_processes_or_threads(bot):
+    result = play(f"{HOSTILE}:{bot}", max_faults=5)
+    if bot == "Forker":
+        assert "forker: ['PermissionError', 'PermissionError']" in result["output"][0]["text"]
+        assert result["faults"][0]["total"] == 0
+    else:
+        assert result["faults"][0]["raised"] == 5
+    # the fixture then checks that no `sleep 1000` and no bot host is left
+
+
+def test_killing_the_match_process_kills_the_bot():
+    code = ("from spacewar.match import play_match\n"
+            "from spacewar import Rules\n"
+            f"play_match('{HOSTILE}:Spinner', 'idle', seed=1, rounds=1)\n")
+    match = subprocess.Popen([sys.executable, "-c", code], cwd=ROOT)
+    deadline = time.monotonic() + 60
+    while not bot_processes() and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert bot_processes(), "the bot never started"
+    time.sleep(0.5)
+    match.send_signal(signal.SIGKILL)
+    match.wait()
+    # the fixture asserts the bot's processes are gone
+
+
+# -- resources and output -------------------------------------------------------------------------
+def test_memory_hog_is_a_memory_fault():
+    result = play(f"{HOSTILE}:MemoryHog", max_faults=3, limits=Limits(memory_mb=512))
+    assert result["faults"][0]["memory"] == 3
+
+
+def test_output_is_captured_capped_and_never_the_match_s_stdout(capsys):
+    args = ["match", "--p1", f"{HOSTILE}:Printer", "--p2", "sniper", "--seed", "3",
+            "--rounds", "1", "--json"]
+    assert main(args) == 0
+    out = capsys.readouterr().out
+    result = json.loads(out)  # the whole stdout is the one JSON result
+    assert result["winner"] == "sniper"
+    shown = result["output"][0]
+    assert shown["text"].startswith('{"winner": "hostile"') and shown["truncated"]
+    assert len(shown["text"]) <= 4096 and shown["bytes"] <= (1 << 16) + (1 << 20)
+
+
+def test_disk_filler_is_stopped_by_its_scratch_limit():
+    result = play(f"{HOSTILE}:DiskFiller")
+    text = result["output"][0]["text"]
+    assert "filler stopped after" in text
+    assert int(text.split("after ")[1].split(" MiB")[0]) <= 64
+
+
+def test_bot_cannot_read_other_files(tmp_path):
+    secret_dir = tmp_path / "elsewhere"
+    secret_dir.mkdir()
+    secret = secret_dir / "secret.txt"
+    secret.write_text("TOP-SECRET-42")
+    bot_dir = tmp_path / "bot"
+    bot_dir.mkdir()
+    source = open(os.path.join(ROOT, "tests", "spacewar", "hostile_bots.py")).read()
+    snooper = write_bot(bot_dir, source + f"\nSnooper.TARGETS = ({str(secret)!r}, "
+                                          f"{os.path.join(ROOT, 'tests', 'spacewar', 'test_match.py')!r})\n")
+    result = play(f"{snooper}:Snooper")
+    text = result["output"][0]["text"]
+    assert "TOP-SECRET-42" not in text and "root:" not in text
+    assert text.count("BLOCKED") >= 4 and result["winner"] == "sniper"
+
+
+def test_bot_cannot_write_outside_its_scratch_directory(tmp_path):
+    source = open(os.path.join(ROOT, "tests", "spacewar", "hostile_bots.py")).read()
+    writer = write_bot(tmp_path, source)
+    result = play(f"{writer}:Writer")
+    assert "WRITTEN" not in result["output"][0]["text"]
+    assert not (tmp_path / "planted.txt").exists() and not os.path.exists("/tmp/planted")
+
+
+def test_bot_has_no_network(tmp_path):
+    listener = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+    listener.bind(("127.0.0.1", 0))
+    listener.listen(1)
+    listener.settimeout(0.2)
+    unix_path = str(tmp_path / "sock")
+    unix = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    unix.bind(unix_path)
+    unix.listen(1)
+    unix.settimeout(0.2)
+    source = open(os.path.join(ROOT, "tests", "spacewar", "hostile_bots.py")).read()
+    bot = write_bot(tmp_path, source + f"\nNetworker.PORT = {listener.getsockname()[1]}\n"
+                                       f"Networker.UNIX_PATH = {unix_path!r}\n")
+    try:
+        result = play(f"{bot}:Networker")
+        for server in (listener, unix):
+            with pytest.raises(socket.timeout):
+                server.accept()
+    finally:
+        listener.close()
+        unix.close()
+    assert "CONNECTED" not in result["output"][0]["text"]
+    assert result["output"][0]["text"].count("BLOCKED") == 3
+
+
+def test_sandbox_probe_reports_every_layer_here():
+    from spacewar.sandbox_probe import probe
+
+    findings = probe()
+    assert findings["ok"], findings
+    assert any(layer.startswith("landlock") for layer in findings["layers"])
+
+
+# -- trusted bots in this process ------------------------------------------------------------------
+class _ExitInline:
+    def act(self, obs):
+        if obs.frame % 3 == 0:
+            raise SystemExit(1)
+        if obs.frame % 3 == 1:
+            raise KeyboardInterrupt
+        class Bad:
+            def __repr__(self):
+                raise RuntimeError("repr bomb")
+        return Bad()
+
+
+class _CodeRaises:
+    def act(self, obs):
+        from spacewar import Action
+
+        class A(Action):
+            def code(self):
+                raise SystemExit("from code()")
+        return A(turn=1)
+
+
+class _Mutator:
+    """Writes into its observation and its rules: neither may reach the game."""
+
+    def __init__(self):
+        self.errors = 0
+
+    def act(self, obs):
+        object.__setattr__(obs.rules, "torpedoes", 1)
+        object.__setattr__(obs.rules, "star_mu", 0.0)
+        try:
+            obs.me.pos[0] = 0.25
+        except ValueError:
+            self.errors += 1
+        return NOOP_ACTION
+
+
+NOOP_ACTION = __import__("spacewar").NOOP
+
+
+def test_inline_bot_exits_and_bad_reprs_are_faults():
+    result = play(_ExitInline(), max_faults=9)
+    f = result["faults"][0]
+    assert f["raised"] == 6 and f["invalid"] == 3
+    assert result["forfeits"] == [True, False]
+
+
+def test_inline_code_override_is_ignored():
+    result = play(_CodeRaises(), "idle", max_faults=3)
+    assert result["faults"][0]["total"] == 0  # the fields are valid; the override never runs
+
+
+def test_inline_bot_mutating_its_observation_changes_nothing(tmp_path):
+    from spacewar import replay as replay_io
+
+    bot = _Mutator()
+    result, rep, _ = play_match(bot, "sniper", seed=3, rounds=1, rules=SHORT, record=True)
+    assert bot.errors > 0  # the arrays are read-only
+    assert result["rules"] == SHORT.to_dict()
+    ok, details = replay_io.check(rep)
+    assert ok, details
