@@ -65,7 +65,10 @@ def project_cache():
     previous = config.CACHE_DIR
     current = cache_dir()
     if os.path.isdir(current):
-        os.utime(current)  # mark it recently used, so pruning keeps it
+        try:
+            os.utime(current)  # mark it recently used, so pruning keeps it
+        except OSError:
+            pass  # a cache we may read but not touch (a bot's sandbox): use it as it is
     else:
         prune(current)
     config.CACHE_DIR = current

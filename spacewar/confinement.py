@@ -49,26 +49,81 @@ DENIED_SYSCALLS = (
     "delete_module", "kexec_load", "kexec_file_load", "reboot", "swapon", "swapoff", "acct",
     "quotactl", "mknod", "mknodat", "setuid", "setgid", "setreuid", "setregid", "setresuid",
     "setresgid", "setgroups",
+    # leaving its session or process group
+    "setsid", "setpgid",
+    # metadata, which Landlock does not cover: a bot holding root's user id would own every file
+    "chmod", "fchmod", "fchmodat", "fchmodat2", "chown", "fchown", "lchown", "fchownat",
+    "utime", "utimes", "utimensat", "futimesat", "setxattr", "lsetxattr", "fsetxattr",
+    "removexattr", "lremovexattr", "fremovexattr",
+    # growing a file past RLIMIT_FSIZE (FALLOC_FL_KEEP_SIZE), watching directories it cannot read
+    "fallocate", "inotify_init", "inotify_init1", "inotify_add_watch", "fanotify_init",
+    "fanotify_mark",
 )
+#: prctl options a bot may not use: clearing its parent-death signal would let it outlive the match
+DENIED_PRCTL = (_PR_SET_PDEATHSIG,)
 
 
 # -- the match's side ------------------------------------------------------------------------
-@functools.lru_cache(maxsize=None)
-def namespaces_available():
-    """Whether ``unshare`` can give a bot its own user, PID, network and mount namespaces."""
-    if not sys.platform.startswith("linux") or shutil.which("unshare") is None:
-        return False
+NOBODY = 65534  # the unprivileged user a bot runs as when the match was started by root
+
+
+def _works(command):
     try:
-        done = subprocess.run(["unshare", *UNSHARE_FLAGS, "true"], stdin=subprocess.DEVNULL,
-                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, timeout=10)
+        done = subprocess.run(command, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                              stderr=subprocess.DEVNULL, timeout=20)
     except (OSError, subprocess.SubprocessError):
         return False
     return done.returncode == 0
 
 
+def _as_nobody():
+    return [shutil.which("setpriv"), f"--reuid={NOBODY}", f"--regid={NOBODY}", "--clear-groups",
+            "--"]
+
+
+def _unshare():
+    return [shutil.which("unshare"), *UNSHARE_FLAGS, "--"]
+
+
+@functools.lru_cache(maxsize=None)
+def launch_plan():
+    """How a bot is started here: ``(prefix words, user, namespaces)``, found once by trying.
+
+    Started by root, a bot runs as ``nobody`` when that user can run this Python and read the
+    project (root ignores some limits and owns files); otherwise it keeps root's user id
+    outside its user namespace, with no capability at all. It gets its namespaces wherever
+    ``unshare`` may create them.
+    """
+    if not sys.platform.startswith("linux") or shutil.which("unshare") is None:
+        return (), None, False
+    check = [sys.executable, "-s", "-B", "-c", "import numpy, spacewar.bothost"]
+    nobody = (os.geteuid() == 0 and shutil.which("setpriv") is not None
+              and _works(_as_nobody() + check))
+    plans = []
+    if nobody:
+        plans += [(_as_nobody() + _unshare(), "nobody", True)]
+    plans += [(_unshare(), "root" if os.geteuid() == 0 else "caller", True)]
+    if nobody:
+        plans += [(_as_nobody(), "nobody", False)]
+    for prefix, user, namespaces in plans:
+        if _works(prefix + check):
+            return tuple(prefix), user, namespaces
+    return (), "root" if os.geteuid() == 0 else "caller", False
+
+
+def namespaces_available():
+    """Whether a bot gets its own user, PID, network, IPC, UTS and mount namespaces here."""
+    return launch_plan()[2]
+
+
 def launch_prefix():
-    """The command words that start a bot host in its own namespaces (empty if unavailable)."""
-    return [shutil.which("unshare"), *UNSHARE_FLAGS, "--"] if namespaces_available() else []
+    """The command words that start a bot host (as nobody, in namespaces) where possible."""
+    return list(launch_plan()[0])
+
+
+def bot_uid():
+    """The user id a bot's files must belong to (None: the caller's own)."""
+    return NOBODY if launch_plan()[1] == "nobody" else None
 
 
 def die_with_parent():
@@ -90,9 +145,15 @@ def confine(config):
     """
     layers = []
     libc = ctypes.CDLL(None, use_errno=True) if sys.platform.startswith("linux") else None
+    # first of all: finding libseccomp runs ldconfig, which the limits and Landlock forbid
+    seccomp = _load_seccomp() if libc is not None else None
     if libc is not None:
         libc.prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
         layers.append("parent-death signal")
+    if config.get("user") == "nobody":
+        layers.append(f"user nobody ({os.getuid()} here, {NOBODY} outside)")
+    elif config.get("user") == "root":
+        layers.append("root's user id outside its namespace (nobody could not start this Python in one)")
     if config.get("namespaces"):
         layers.append("namespaces (user, pid, net, ipc, uts, mount)")
         if _mount_scratch(libc, config["scratch"], config["scratch_mb"]):
@@ -103,7 +164,6 @@ def confine(config):
     layers.append("rlimits")
     if libc is not None:
         signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # an over-long write fails, not the bot
-        seccomp = _load_seccomp()  # before Landlock: finding libseccomp reads and runs ldconfig
         _drop_bounding_set(libc)
         try:
             from . import landlock
@@ -202,6 +262,9 @@ def _seccomp(pyseccomp):
                 rules.add_rule(pyseccomp.ERRNO(errno.EPERM), name)
             except (RuntimeError, ValueError, OSError):
                 continue  # not a system call on this architecture
+        for option in DENIED_PRCTL:
+            rules.add_rule(pyseccomp.ERRNO(errno.EPERM), "prctl",
+                           pyseccomp.Arg(0, pyseccomp.EQ, option))
         rules.load()
     except (RuntimeError, OSError, AttributeError):
         return False

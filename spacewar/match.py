@@ -18,7 +18,7 @@ import numpy as np
 from . import core
 from .game import Game
 from .rules import Rules
-from .seats import FAULT_KINDS, Limits, bot_name, open_seat
+from .seats import FAULT_KINDS, Limits, bot_name, open_seat, printable
 
 DEFAULT_BUDGET = 0.05  # seconds per action
 DEFAULT_MAX_FAULTS = 25
@@ -40,7 +40,8 @@ class FaultLog:
 
     def add(self, frame, kind, message):
         self.counts[kind] += 1
-        self.last = {"frame": int(frame), "kind": kind, "message": str(message)[:MAX_MESSAGE]}
+        self.last = {"frame": int(frame), "kind": kind,
+                     "message": printable(str(message))[:MAX_MESSAGE]}
         if len(self.examples) < 5:
             self.examples.append(self.last)
 

@@ -23,6 +23,7 @@ copy of the rules. ``ProcessSeat`` runs any other bot in its own confined proces
 messages (``spacewar.wire``); the match never blocks on it: every wait has a deadline.
 """
 import dataclasses
+import json
 import math
 import os
 import select
@@ -149,6 +150,12 @@ class InlineSeat:
         return {"text": "", "bytes": 0, "truncated": False}
 
 
+def printable(text):
+    """``text`` with every control character (terminal escapes, newlines) shown escaped, so a
+    bot's message cannot redraw the terminal it is printed on."""
+    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
+
+
 def _exception_text(exc):
     try:
         text = f"{type(exc).__name__}: {exc}"
@@ -196,19 +203,25 @@ class ProcessSeat:
         self._pending = None  # (frame, time sent) of the observation awaiting an answer
         self._reader = wire.AnswerReader()
         self._proc = None
+        self._host = None
         self._dir = tempfile.mkdtemp(prefix="spacewar-bot-")
         scratch = os.path.join(self._dir, "scratch")
         os.mkdir(scratch, 0o700)
         self._log = os.path.join(self._dir, "output.log")
         read_dirs, list_dirs, search_path = _bot_files(spec)
         dirs, files = confinement.read_paths(extra_dirs=read_dirs)
-        namespaces = bool(confinement.launch_prefix())
+        _, user, namespaces = confinement.launch_plan()
+        self._namespaces = namespaces
+        if confinement.bot_uid() is not None:  # the bot runs as nobody: its directories are its
+            for path in (self._dir, scratch):
+                os.chown(path, confinement.bot_uid(), confinement.bot_uid())
         config = {
             "spec": absolute_spec(spec), "seed": int(seed), "rules": rules.to_dict(), "path": search_path,
             "output_bytes": limits.output_bytes,
             "confinement": {"numba_cache": _compiled_code_dir(),"scratch": scratch, "scratch_mb": limits.scratch_mb,
                             "memory_mb": limits.memory_mb, "file_mb": limits.file_mb,
                             "max_files": limits.max_files, "namespaces": namespaces,
+                            "user": user,
                             "cpu_seconds": cpu_seconds or limits.cpu_seconds or 3600,
                             "read_dirs": dirs, "read_files": files, "list_dirs": list_dirs},
         }
@@ -249,8 +262,9 @@ class ProcessSeat:
                                              f"{self.limits.startup:g} s")
             frame, status, code, text = answer
             if status == wire.READY and frame == -1:
+                self._find_host()
                 try:
-                    self.layers = [str(x) for x in __import__("json").loads(text)][:16]
+                    self.layers = [printable(str(x)) for x in json.loads(text)][:16]
                 except (ValueError, TypeError):
                     self.layers = []
                 return None
@@ -379,14 +393,38 @@ class ProcessSeat:
         self._kill()
         return self.dead
 
-    def _kill(self):
-        if self._proc is None or self._proc.returncode is not None:
+    def _find_host(self):
+        """Hold the bot host itself by a pidfd: under ``unshare`` it is unshare's child, and
+        it must be killed by its own pid (a bot may leave its process group). Killing it, the
+        first process of its PID namespace, makes the kernel kill everything in it."""
+        if self._host is not None or self._proc is None or not self._namespaces:
             return
         try:
-            os.killpg(self._proc.pid, signal.SIGKILL)  # the bot's session: it and all it started
+            with open(f"/proc/{self._proc.pid}/task/{self._proc.pid}/children") as f:
+                children = [int(x) for x in f.read().split()]
+            if children:
+                self._host = os.pidfd_open(children[0])
+        except (OSError, ValueError, AttributeError):
+            pass
+
+    def _kill(self):
+        if self._proc is None:
+            return
+        self._find_host()
+        if self._host is not None and self._host >= 0:
+            try:
+                signal.pidfd_send_signal(self._host, signal.SIGKILL)
+            except OSError:
+                pass
+            os.close(self._host)
+            self._host = -1  # found once, killed once
+        if self._proc.returncode is not None:
+            return
+        try:
+            os.killpg(self._proc.pid, signal.SIGKILL)  # its session: it and all it started
         except (ProcessLookupError, PermissionError):
             pass
-        self._proc.kill()
+        self._proc.kill()  # by pid too, in case it left its process group
         self._proc.wait()
 
     def close(self):

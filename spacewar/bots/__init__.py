@@ -66,12 +66,19 @@ def locate(spec):
         path = os.path.abspath(where)
         if not os.path.isfile(path):
             raise BotLoadError(f"bot file {where!r} does not exist")
-        return [os.path.dirname(path)], [], None
+        return [path], [], None  # the file alone: its directory may hold other people's bots
     top = where.split(".")[0]
     if not all(part.isidentifier() for part in where.split(".")):
         raise BotLoadError(f"{where!r} in bot {spec!r} is not a module name")
-    search = [os.getcwd()] + [p for p in sys.path if p]
-    found = importlib.machinery.PathFinder.find_spec(top, search)
+    # a module in the current directory (as ``python -m`` would find it), else an installed one;
+    # finding a top-level module's spec runs none of its code
+    found = importlib.machinery.PathFinder.find_spec(top, [os.getcwd()])
+    local = found is not None
+    if found is None:
+        try:
+            found = importlib.util.find_spec(top)
+        except (ImportError, ValueError):
+            found = None
     if found is None:
         raise BotLoadError(f"cannot import module {where!r} for bot {spec!r}: "
                            f"no module named {top!r} in the current directory or on sys.path")
@@ -82,7 +89,7 @@ def locate(spec):
     else:
         raise BotLoadError(f"module {top!r} for bot {spec!r} has no files to load")
     parents = sorted({os.path.dirname(os.path.abspath(r)) for r in roots})
-    return roots, parents, parents[0]
+    return roots, parents, (parents[0] if local else None)
 
 
 def absolute_spec(spec):

@@ -337,3 +337,84 @@ class Writer:
 
     def act(self, obs):
         return NOOP
+
+
+# -- found by the red team ------------------------------------------------------------------------
+class Lingerer:
+    """Clears its parent-death signal, leaves its process group and replaces ``os._exit`` so
+    that its host never exits: it would outlive the match and the match's process."""
+
+    def reset(self):
+        import ctypes
+        self.prctl = ctypes.CDLL(None, use_errno=True).prctl(1, 0, 0, 0, 0)
+        try:
+            os.setsid()
+            self.setsid = "done"
+        except OSError as exc:
+            self.setsid = type(exc).__name__
+
+        def linger(code=0):
+            while True:
+                time.sleep(3600)
+        os._exit = linger
+        print("lingerer:", self.prctl, self.setsid, flush=True)
+
+    def act(self, obs):
+        return NOOP
+
+
+class MetadataVandal:
+    """chmod, utime, xattr and fallocate on files outside its scratch directory (TARGET, set by
+    the test) and on its own stdout, which is a file of the match's."""
+
+    TARGET = "/nonexistent"
+
+    def reset(self):
+        import ctypes
+        outcome = {}
+        for name, attempt in (
+                ("chmod", lambda: os.chmod(self.TARGET, 0o4777)),
+                ("utime", lambda: os.utime(self.TARGET, (0, 0))),
+                ("setxattr", lambda: os.setxattr(self.TARGET, "user.x", b"pwned")),
+                ("fallocate", lambda: self._fallocate(ctypes))):
+            try:
+                attempt()
+                outcome[name] = "DONE"
+            except OSError as exc:
+                outcome[name] = f"BLOCKED {type(exc).__name__}"
+        print(repr(outcome), flush=True)
+
+    @staticmethod
+    def _fallocate(ctypes):
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.fallocate.argtypes = [ctypes.c_int, ctypes.c_int, ctypes.c_long, ctypes.c_long]
+        if libc.fallocate(1, 1, 0, 1 << 30) != 0:  # FALLOC_FL_KEEP_SIZE, 1 GiB
+            raise OSError(ctypes.get_errno(), "fallocate")
+
+    def act(self, obs):
+        return NOOP
+
+
+class Watcher:
+    """inotify on a directory it may not read: it would learn the names of files made there."""
+
+    TARGET = "/tmp"
+
+    def reset(self):
+        import ctypes
+        libc = ctypes.CDLL(None, use_errno=True)
+        fd = libc.inotify_init1(0)
+        watch = libc.inotify_add_watch(fd, self.TARGET.encode(), 0xFFF) if fd >= 0 else -1
+        print("watcher:", "WATCHING" if watch >= 0 else "BLOCKED", flush=True)
+
+    def act(self, obs):
+        return NOOP
+
+
+class TerminalSpoofer:
+    """A fault message full of terminal escapes, to redraw the summary line as its own win."""
+
+    def act(self, obs):
+        if obs.frame == 0:
+            raise RuntimeError("\x1b[2K\r\x1b[1A\x1b[2K\rhostile beats sniper 1-0\n  score 1 - 0")
+        return NOOP

@@ -63,9 +63,24 @@ def nothing_left_running(monkeypatch):
     assert bot_processes() == []
 
 
+@pytest.fixture
+def tmp_path():
+    """A directory anyone may read (pytest's own is root's alone, and a bot started by root
+    runs as nobody where it can), so that only the sandbox stands between bot and file."""
+    import pathlib
+    import shutil
+    import tempfile
+
+    path = pathlib.Path(tempfile.mkdtemp(prefix="spacewar-test-"))
+    path.chmod(0o755)
+    yield path
+    shutil.rmtree(path, ignore_errors=True)
+
+
 def write_bot(tmp_path, source, name="bot.py"):
     path = tmp_path / name
     path.write_text(textwrap.dedent(source))
+    path.chmod(0o644)
     return str(path)
 
 
@@ -113,6 +128,7 @@ def test_import_time_patch_of_the_match_does_not_rig_a_tournament(tmp_path):
         report, _ = run_tournament([f"{rigger}:Rigger", "sniper"], workers=workers, **kw)
         rows = {r["bot"]: r for r in report["table"]}
         assert rows["sniper"]["wins"] == 2 and rows[f"{rigger}:Rigger"]["wins"] == 0
+        assert rows[f"{rigger}:Rigger"]["faults"] == 0  # it did start, and patched its own copy
 
 
 def test_exit_at_import_forfeits_and_the_tournament_prints_its_table(tmp_path, capsys):
@@ -130,6 +146,9 @@ def test_exit_at_import_forfeits_and_the_tournament_prints_its_table(tmp_path, c
     rows = {r["bot"]: r for r in report["table"]}
     assert rows[f"{dead}:Dead"]["forfeits"] == 4 and rows[f"{dead}:Dead"]["wins"] == 0
     assert rows["sniper"]["played"] == 4
+    result, _, _ = play_match(f"{dead}:Dead", "idle", seed=1, rounds=1)
+    assert "died while starting: bot process exited (code 9)" in \
+        result["faults"][0]["examples"][0]["message"]
 
 
 # -- answers that used to crash the match --------------------------------------------------------
@@ -212,10 +231,20 @@ def test_bots_cannot_start_processes_or_threads(bot):
     # the fixture then checks that no `sleep 1000` and no bot host is left
 
 
-def test_killing_the_match_process_kills_the_bot():
+def test_a_bot_that_would_outlive_its_match_does_not():
+    """Clearing the parent-death signal and leaving the process group are refused (seccomp);
+    even where they are not, the match kills the bot's host by its own pid."""
+    result = play(f"{HOSTILE}:Lingerer")
+    assert result["winner"] == "sniper" and result["faults"][0]["total"] == 0
+    assert "lingerer: -1 PermissionError" in result["output"][0]["text"]
+    # the fixture asserts nothing is left
+
+
+@pytest.mark.parametrize("bot", ["Spinner", "Lingerer"])
+def test_killing_the_match_process_kills_the_bot(bot):
     code = ("from spacewar.match import play_match\n"
             "from spacewar import Rules\n"
-            f"play_match('{HOSTILE}:Spinner', 'idle', seed=1, rounds=1)\n")
+            f"play_match('{HOSTILE}:{bot}', 'idle', seed=1, rounds=1)\n")
     match = subprocess.Popen([sys.executable, "-c", code], cwd=ROOT)
     deadline = time.monotonic() + 60
     while not bot_processes() and time.monotonic() < deadline:
@@ -254,18 +283,22 @@ def test_disk_filler_is_stopped_by_its_scratch_limit():
 
 def test_bot_cannot_read_other_files(tmp_path):
     secret_dir = tmp_path / "elsewhere"
-    secret_dir.mkdir()
+    secret_dir.mkdir(mode=0o755)
     secret = secret_dir / "secret.txt"
     secret.write_text("TOP-SECRET-42")
+    secret.chmod(0o644)  # readable by anyone: only the sandbox keeps the bot from it
     bot_dir = tmp_path / "bot"
-    bot_dir.mkdir()
+    bot_dir.mkdir(mode=0o755)
     source = open(os.path.join(ROOT, "tests", "spacewar", "hostile_bots.py")).read()
-    snooper = write_bot(bot_dir, source + f"\nSnooper.TARGETS = ({str(secret)!r}, "
+    sibling = bot_dir / "other_bot.py"  # another author's bot in the same directory
+    sibling.write_text("SIBLING-SOURCE-7")
+    sibling.chmod(0o644)
+    snooper = write_bot(bot_dir, source + f"\nSnooper.TARGETS = ({str(secret)!r}, {str(sibling)!r}, "
                                           f"{os.path.join(ROOT, 'tests', 'spacewar', 'test_match.py')!r})\n")
     result = play(f"{snooper}:Snooper")
     text = result["output"][0]["text"]
-    assert "TOP-SECRET-42" not in text and "root:" not in text
-    assert text.count("BLOCKED") >= 4 and result["winner"] == "sniper"
+    assert "TOP-SECRET-42" not in text and "SIBLING-SOURCE-7" not in text and "root:" not in text
+    assert text.count("BLOCKED") >= 5 and result["winner"] == "sniper"
 
 
 def test_bot_cannot_write_outside_its_scratch_directory(tmp_path):
@@ -274,6 +307,36 @@ def test_bot_cannot_write_outside_its_scratch_directory(tmp_path):
     result = play(f"{writer}:Writer")
     assert "WRITTEN" not in result["output"][0]["text"]
     assert not (tmp_path / "planted.txt").exists() and not os.path.exists("/tmp/planted")
+
+
+def test_bot_cannot_change_metadata_or_grow_its_output_file(tmp_path):
+    target = tmp_path / "victim.py"
+    target.write_text("print('victim')\n")
+    target.chmod(0o644)
+    before = os.stat(target)
+    source = open(os.path.join(ROOT, "tests", "spacewar", "hostile_bots.py")).read()
+    bot = write_bot(tmp_path, source + f"\nMetadataVandal.TARGET = {str(target)!r}\n")
+    result = play(f"{bot}:MetadataVandal")
+    text = result["output"][0]["text"]
+    assert "DONE" not in text and text.count("BLOCKED") == 4
+    after = os.stat(target)
+    assert (after.st_mode, after.st_mtime_ns) == (before.st_mode, before.st_mtime_ns)
+    assert result["output"][0]["bytes"] < 4096
+
+
+def test_bot_cannot_watch_directories(tmp_path):
+    source = open(os.path.join(ROOT, "tests", "spacewar", "hostile_bots.py")).read()
+    bot = write_bot(tmp_path, source + f"\nWatcher.TARGET = {str(tmp_path)!r}\n")
+    result = play(f"{bot}:Watcher")
+    assert "watcher: BLOCKED" in result["output"][0]["text"]
+
+
+def test_fault_messages_cannot_redraw_the_terminal(capsys):
+    assert main(["match", "--p1", f"{HOSTILE}:TerminalSpoofer", "--p2", "sniper", "--seed", "3",
+                 "--rounds", "1"]) == 0
+    out = capsys.readouterr().out
+    assert "\x1b" not in out and "\\x1b[2K" in out
+    assert out.splitlines()[0].startswith("sniper beats")
 
 
 def test_bot_has_no_network(tmp_path):
