@@ -358,6 +358,60 @@ def reset_all(pos, vel, mass, charge, active, ship_f, ship_i, torp_life, mi, rp)
         reset_round(m, pos, vel, mass, charge, active, ship_f, ship_i, torp_life, mi, rp)
 
 
+@njit(cache=True)
+def write_observation(m, seat, pos, vel, charge, active, ship_f, ship_i, torp_life, mi, rp, raw):
+    """Match ``m`` seen from ``seat`` as the flat array of ``spacewar.protocol.raw_layout``:
+    10 header numbers, the own ship's 15, the enemy's 15, then 8 per torpedo slot (own slots
+    first, each with a presence flag; an empty slot is all zeros)."""
+    raw[0] = mi[m, FRAME]
+    raw[1] = mi[m, ROUND_FRAME]
+    raw[2] = mi[m, ROUNDS_PLAYED]
+    raw[3] = mi[m, SCORE0 + seat]
+    raw[4] = mi[m, SCORE0 + 1 - seat]
+    raw[5] = seat
+    raw[6] = rp[R_STAR]
+    raw[7] = rp[R_CAPTURE]
+    raw[8] = 0.0
+    raw[9] = 0.0
+    for row in range(2):
+        s = seat if row == 0 else 1 - seat
+        o = 10 + 15 * row
+        raw[o] = pos[m, 0, s]
+        raw[o + 1] = pos[m, 1, s]
+        raw[o + 2] = vel[m, 0, s]
+        raw[o + 3] = vel[m, 1, s]
+        raw[o + 4] = ship_f[m, s, HEADING]
+        raw[o + 5] = ship_f[m, s, OMEGA]
+        raw[o + 6] = ship_f[m, s, FUEL]
+        raw[o + 7] = ship_i[m, s, TORPS]
+        raw[o + 8] = ship_i[m, s, HYPER_LEFT]
+        raw[o + 9] = ship_i[m, s, ALIVE]
+        raw[o + 10] = ship_i[m, s, IN_HYPER]
+        raw[o + 11] = ship_i[m, s, RELOAD]
+        raw[o + 12] = ship_i[m, s, HYPER_RECHARGE]
+        raw[o + 13] = charge[m, s]
+        raw[o + 14] = ship_i[m, s, FLIP_CD]
+    t = torp_life.shape[1] // 2
+    o = 40
+    for row in range(2):
+        owner = seat if row == 0 else 1 - seat
+        for k in range(t):
+            b = 2 + owner * t + k
+            if active[m, b]:
+                raw[o] = 1.0
+                raw[o + 1] = pos[m, 0, b]
+                raw[o + 2] = pos[m, 1, b]
+                raw[o + 3] = vel[m, 0, b]
+                raw[o + 4] = vel[m, 1, b]
+                raw[o + 5] = 1.0 if row == 0 else 0.0
+                raw[o + 6] = torp_life[m, owner * t + k]
+                raw[o + 7] = charge[m, b]
+            else:
+                for j in range(8):
+                    raw[o + j] = 0.0
+            o += 8
+
+
 def drift_kick():
     """The engine's symplectic Euler coefficients: kick then drift, as the 1962 game."""
     return splitting.coefficients("symplectic_euler")

@@ -187,33 +187,11 @@ class Game:
     def raw_observation(self, m, seat, out=None):
         """The observation of match ``m`` from seat ``seat`` as a flat float64 array
         (``spacewar.protocol.raw_layout`` names its entries); written into ``out`` if given."""
-        rules = self.rules
-        t = rules.torpedoes
-        raw = np.empty(raw_length(rules)) if out is None else out
-        mi = self.mi[m]
-        raw[:10] = (mi[core.FRAME], mi[core.ROUND_FRAME], mi[core.ROUNDS_PLAYED],
-                    mi[core.SCORE0 + seat], mi[core.SCORE0 + 1 - seat], seat,
-                    rules.effective_star_mu, rules.star_capture, 0.0, 0.0)
-        for row, s in enumerate((seat, 1 - seat)):
-            f = self.ship_f[m, s]
-            i = self.ship_i[m, s]
-            o = 10 + 15 * row
-            raw[o:o + 15] = (self.pos[m, 0, s], self.pos[m, 1, s], self.vel[m, 0, s],
-                             self.vel[m, 1, s], f[core.HEADING], f[core.OMEGA], f[core.FUEL],
-                             i[core.TORPS], i[core.HYPER_LEFT], i[core.ALIVE], i[core.IN_HYPER],
-                             i[core.RELOAD], i[core.HYPER_RECHARGE], self.charge[m, s],
-                             i[core.FLIP_CD])
-        o = 40
-        for row, owner in enumerate((seat, 1 - seat)):
-            for k in range(t):
-                b = 2 + owner * t + k
-                if self.active[m, b]:
-                    raw[o:o + 8] = (1.0, self.pos[m, 0, b], self.pos[m, 1, b], self.vel[m, 0, b],
-                                    self.vel[m, 1, b], float(owner == seat),
-                                    self.torp_life[m, owner * t + k], self.charge[m, b])
-                else:
-                    raw[o:o + 8] = 0.0
-                o += 8
+        if not 0 <= m < self.n_matches or seat not in (0, 1):
+            raise ValueError(f"no seat {seat!r} of match {m!r} in {self.n_matches} matches")
+        raw = np.empty(raw_length(self.rules)) if out is None else out
+        core.write_observation(int(m), int(seat), self.pos, self.vel, self.charge, self.active,
+                               self.ship_f, self.ship_i, self.torp_life, self.mi, self.rp, raw)
         return raw
 
     def observe(self, m, seat, rules=None):

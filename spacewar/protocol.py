@@ -133,9 +133,13 @@ class Observation:
     seat: int  # 0 or 1
     rules: object = field(repr=False)
     _vector: np.ndarray = field(repr=False, default=None)
+    _raw: np.ndarray = field(repr=False, default=None, compare=False)
+    _decode_rules: object = field(repr=False, default=None, compare=False)
 
     def vector(self):
-        """A flat float64 vector of fixed length (see ``VECTOR_LAYOUT``), for learning code."""
+        """A flat float64 vector of fixed length (see ``vector_layout``), for learning code."""
+        if self._vector is None and self._raw is not None:  # made on first use only
+            object.__setattr__(self, "_vector", _vector_from_raw(self._raw, self._decode_rules))
         return self._vector.copy()
 
 
@@ -186,19 +190,19 @@ def _frozen(array):
 
 
 def _ship_from_raw(r):
-    return Ship(pos=_frozen(r[0:2].copy()), vel=_frozen(r[2:4].copy()), heading=float(r[4]),
-                angular_velocity=float(r[5]), fuel=float(r[6]), torpedoes=int(r[7]),
-                hyperspace=int(r[8]), alive=bool(r[9]), in_hyperspace=bool(r[10]),
-                reload=int(r[11]), hyperspace_recharge=int(r[12]), charge=float(r[13]),
-                flip_cooldown=int(r[14]))
+    """A Ship from its 15 raw numbers ``r`` (a read-only array: pos and vel are views of it)."""
+    x = r.tolist()
+    return Ship(pos=r[0:2], vel=r[2:4], heading=x[4], angular_velocity=x[5], fuel=x[6],
+                torpedoes=int(x[7]), hyperspace=int(x[8]), alive=bool(x[9]),
+                in_hyperspace=bool(x[10]), reload=int(x[11]), hyperspace_recharge=int(x[12]),
+                charge=x[13], flip_cooldown=int(x[14]))
 
 
-def _ship_vector(ship, rules):
-    return [ship.pos[0], ship.pos[1], ship.vel[0], ship.vel[1], np.cos(ship.heading),
-            np.sin(ship.heading), ship.angular_velocity, ship.fuel / max(rules.fuel, 1e-300),
-            ship.torpedoes / rules.torpedoes, ship.hyperspace / max(rules.hyperspace_jumps, 1),
-            float(ship.alive), float(ship.in_hyperspace), ship.reload / max(rules.reload, 1),
-            float(np.sign(ship.charge)), ship.flip_cooldown / max(rules.flip_cooldown, 1)]
+def _ship_vector(x, rules):
+    """One ship's part of ``Observation.vector()`` from its raw numbers (a list)."""
+    return [x[0], x[1], x[2], x[3], np.cos(x[4]), np.sin(x[4]), x[5], x[6] / max(rules.fuel, 1e-300),
+            x[7] / rules.torpedoes, x[8] / max(rules.hyperspace_jumps, 1), x[9], x[10],
+            x[11] / max(rules.reload, 1), float(np.sign(x[13])), x[14] / max(rules.flip_cooldown, 1)]
 
 
 def observation_from_raw(raw, rules, shown_rules=None):
@@ -207,24 +211,30 @@ def observation_from_raw(raw, rules, shown_rules=None):
     raw = np.asarray(raw, dtype=np.float64)
     if raw.shape != (raw_length(rules),):
         raise ValueError(f"raw observation must have shape ({raw_length(rules)},), got {raw.shape}")
-    h = raw[:_NH]
-    me = _ship_from_raw(raw[_NH:_NH + _NS])
-    enemy = _ship_from_raw(raw[_NH + _NS:_NH + 2 * _NS])
+    h = raw[:_NH].tolist()
+    ships = _frozen(raw[_NH:_NH + 2 * _NS].copy())
+    me, enemy = _ship_from_raw(ships[:_NS]), _ship_from_raw(ships[_NS:])
     slots = raw[_NH + 2 * _NS:].reshape(-1, _NT)
-    torpedoes = []
+    live = _frozen(slots[slots[:, 0] != 0.0])
+    torpedoes = tuple(Torpedo(pos=row[1:3], vel=row[3:5], mine=bool(x[5]), ttl=int(x[6]),
+                              charge=x[7]) for row, x in zip(live, live.tolist()))
+    return Observation(me=me, enemy=enemy, torpedoes=torpedoes,
+                       star_pos=_frozen(np.array(h[8:10])), star_mu=h[6], star_capture=h[7],
+                       frame=int(h[0]), round_frame=int(h[1]), round=int(h[2]),
+                       score=(int(h[3]), int(h[4])), seat=int(h[5]),
+                       rules=rules if shown_rules is None else shown_rules,
+                       _raw=_frozen(raw.copy()), _decode_rules=rules)
+
+
+def _vector_from_raw(raw, rules):
+    """``Observation.vector()`` from the raw observation (see ``vector_layout``)."""
+    numbers = raw[_NH:_NH + 2 * _NS].tolist()
+    slots = raw[_NH + 2 * _NS:].reshape(-1, _NT)
+    present = slots[:, 0] != 0.0
     vec_t = np.zeros((slots.shape[0], 7))
-    for k, slot in enumerate(slots):
-        if slot[0] == 0.0:
-            continue
-        torpedoes.append(Torpedo(pos=_frozen(slot[1:3].copy()), vel=_frozen(slot[3:5].copy()),
-                                 mine=bool(slot[5]), ttl=int(slot[6]), charge=float(slot[7])))
-        vec_t[k] = (1.0, slot[1], slot[2], slot[3], slot[4], slot[5],
-                    slot[6] / max(rules.torpedo_life, 1))
-    vector = np.concatenate((_ship_vector(me, rules), _ship_vector(enemy, rules),
-                             [h[6] / max(rules.star_mu, 1e-300), h[1] / rules.max_round_frames],
-                             vec_t.ravel()))
-    return Observation(me=me, enemy=enemy, torpedoes=tuple(torpedoes),
-                       star_pos=_frozen(h[8:10].copy()), star_mu=float(h[6]),
-                       star_capture=float(h[7]), frame=int(h[0]), round_frame=int(h[1]),
-                       round=int(h[2]), score=(int(h[3]), int(h[4])), seat=int(h[5]),
-                       rules=rules if shown_rules is None else shown_rules, _vector=vector)
+    vec_t[:, :6] = slots[:, :6]
+    vec_t[:, 6] = slots[:, 6] / max(rules.torpedo_life, 1)
+    vec_t[~present] = 0.0
+    return np.concatenate((_ship_vector(numbers[:_NS], rules) + _ship_vector(numbers[_NS:], rules)
+                           + [raw[6] / max(rules.star_mu, 1e-300), raw[1] / rules.max_round_frames],
+                           vec_t.ravel()))

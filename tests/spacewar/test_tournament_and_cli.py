@@ -70,3 +70,36 @@ def test_cli_bots_and_help():
                                text=True, check=True).stdout
     for command in ("bots", "match", "replay", "tournament", "play"):
         assert command in help_text
+
+
+@pytest.mark.parametrize("option, value, message", [
+    ("--budget-ms", "nan", "must be finite"), ("--budget-ms", "inf", "must be finite"),
+    ("--budget-ms", "0", "must be > 0"), ("--overage-ms", "-1", "must be >= 0"),
+    ("--rounds", str(10 ** 20), "must be in [1, 1000000]"), ("--seed", "-3", "must be in [0,"),
+])
+def test_cli_numbers_are_checked(capsys, option, value, message):
+    with pytest.raises(SystemExit) as stop:
+        main(["match", "--p1", "idle", "--p2", "idle", option, value])
+    assert stop.value.code == 2 and message in capsys.readouterr().err
+
+
+def test_cli_bad_replay_path_fails_before_the_match(capsys, monkeypatch, tmp_path):
+    import spacewar.match
+
+    played = []
+    monkeypatch.setattr(spacewar.match, "play_match", lambda *a, **k: played.append(1))
+    assert main(["match", "--p1", "idle", "--p2", "idle", "--replay",
+                 str(tmp_path / "missing" / "r.json")]) == 2
+    assert "does not exist" in capsys.readouterr().err and played == []
+    (tmp_path / "game.gif").write_bytes(b"GIF89a" + b"\0" * 20)
+    assert main(["match", "--p1", "idle", "--p2", "idle", "--replay",
+                 str(tmp_path / "game.gif")]) == 2  # a GIF is not replaced by a replay
+    assert played == [] and (tmp_path / "game.gif").read_bytes().startswith(b"GIF89a")
+
+
+def test_help_of_every_command_shows_the_defaults():
+    for command in ("match", "tournament", "replay", "play", "sandbox"):
+        text = subprocess.run([sys.executable, "-m", "spacewar", command, "--help"],
+                              capture_output=True, text=True, check=True).stdout
+        if command in ("match", "tournament"):
+            assert "(default: 50.0)" in text and "(default: 1000.0)" in text
