@@ -23,6 +23,7 @@ copy of the rules. ``ProcessSeat`` runs any other bot in its own confined proces
 messages (``spacewar.wire``); the match never blocks on it: every wait has a deadline.
 """
 import dataclasses
+import functools
 import json
 import math
 import os
@@ -451,7 +452,9 @@ class ProcessSeat:
             self._kill()
 
 
+@functools.lru_cache(maxsize=None)
 def _compiled_code_dir():
+    """The project's compiled-code directory (named by a hash of its sources: found once)."""
     from engine._cache import cache_dir
 
     return cache_dir()

@@ -342,7 +342,12 @@ def bench_spacewar(matches=256, frames=2000):
     from spacewar import Game, Rules
     from spacewar.match import play_match
 
+    play_match("chaser", "sniper", seed=1, rounds=1)  # compiled code loaded, bots' too
     result, _, timing = play_match("chaser", "sniper", seed=1, rounds=3)
+    # the same match with both bots each in its own confined process (as untrusted bots run)
+    confined, _, confined_timing = play_match("chaser", "sniper", seed=1, rounds=3,
+                                              isolation="process")
+    assert confined["steps"] == result["steps"] and confined["score"] == result["score"]
     rng = np.random.default_rng(0)
     game = Game(Rules(), seeds=range(matches), rounds=1000)
     game.step(rng.integers(0, 48, size=(matches, 2)))
@@ -359,6 +364,10 @@ def bench_spacewar(matches=256, frames=2000):
     return {
         "one_match_with_bots": {"bots": result["bots"], "frames": result["steps"],
                                 "frames_per_second": timing["frames_per_second"]},
+        "one_match_confined_bots": {
+            "frames_per_second": confined_timing["frames_per_second"],
+            "wall_seconds": confined_timing["wall_seconds"],
+            "slowdown": timing["frames_per_second"] / confined_timing["frames_per_second"]},
         "one_match_no_bots_frames_per_second": frames / alone,
         "batch": {"matches": matches, "frames": frames,
                   "match_frames_per_second": matches * frames / batch},
@@ -530,7 +539,9 @@ def format_report(r):
         s = r["spacewar"]
         one = s["one_match_with_bots"]
         lines.append(f"\n6. Spacewar: one match {one['bots'][0]} vs {one['bots'][1]} with bots "
-                     f"{one['frames_per_second']:.0f} frames/s; without bots "
+                     f"{one['frames_per_second']:.0f} frames/s; both bots confined in their "
+                     f"own processes {s['one_match_confined_bots']['frames_per_second']:.0f} "
+                     f"frames/s; without bots "
                      f"{s['one_match_no_bots_frames_per_second']:.0f} frames/s; "
                      f"{s['batch']['matches']} matches together "
                      f"{s['batch']['match_frames_per_second']:.3e} match-frames/s")
@@ -608,6 +619,11 @@ def format_markdown(r, command):
         out += ["## 6. Headless Spacewar", "",
                 f"- one match, {one['bots'][0]} vs {one['bots'][1]}, bots included: "
                 f"{one['frames_per_second']:.0f} frames per second",
+                f"- the same match with each bot confined in its own process (as every bot that "
+                f"is not built in plays): {s['one_match_confined_bots']['frames_per_second']:.0f} "
+                f"frames per second, {s['one_match_confined_bots']['slowdown']:.2f}x the time, "
+                f"start-up of both processes included "
+                f"({s['one_match_confined_bots']['wall_seconds']:.2f} s in all)",
                 f"- one match, no bots (action codes only): {s['one_match_no_bots_frames_per_second']:.0f} "
                 "frames per second",
                 f"- {s['batch']['matches']} matches advanced together by one compiled call: "
