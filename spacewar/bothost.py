@@ -53,15 +53,6 @@ class _CappedOutput(io.RawIOBase):
         return len(data)
 
 
-def _message(exc):
-    """``Kind: text`` of an exception, capped, even when its ``__str__`` misbehaves."""
-    try:
-        text = f"{type(exc).__name__}: {exc}"
-    except BaseException:
-        text = f"{type(exc).__name__} (its message could not be shown)"
-    return text[:wire.MAX_TEXT]
-
-
 def _capture_output(cap):
     raw = _CappedOutput(1, cap)
     stream = io.TextIOWrapper(io.BufferedWriter(raw), encoding="utf-8", errors="replace",
@@ -91,13 +82,13 @@ def _answer(bot, rules, frame, raw):
     except MemoryError:
         return wire.pack_answer(frame, wire.MEMORY, 0, "MemoryError in act")
     except BaseException as exc:  # SystemExit and KeyboardInterrupt from a bot are its faults
-        return wire.pack_answer(frame, wire.RAISED, 0, _message(exc))
+        return wire.pack_answer(frame, wire.RAISED, 0, wire.exception_text(exc))
     try:
         return wire.pack_answer(frame, wire.OK, action_code(result))
     except ValueError as exc:
         return wire.pack_answer(frame, wire.INVALID, 0, f"returned an invalid answer: {exc}")
     except BaseException as exc:
-        return wire.pack_answer(frame, wire.INVALID, 0, _message(exc))
+        return wire.pack_answer(frame, wire.INVALID, 0, wire.exception_text(exc))
 
 
 def main(argv):
@@ -112,7 +103,7 @@ def main(argv):
         layers = confinement.confine(config["confinement"])
     except BaseException as exc:
         _write_all(fd_out, wire.pack_answer(-1, wire.STARTUP, 0,
-                                            "confinement failed: " + _message(exc)))
+                                            "confinement failed: " + wire.exception_text(exc)))
         os._exit(3)
     _capture_output(int(config["output_bytes"]))
     try:
@@ -121,7 +112,7 @@ def main(argv):
         _write_all(fd_out, wire.pack_answer(-1, wire.MEMORY, 0, "MemoryError while starting"))
         os._exit(4)
     except BaseException as exc:
-        _write_all(fd_out, wire.pack_answer(-1, wire.STARTUP, 0, _message(exc)))
+        _write_all(fd_out, wire.pack_answer(-1, wire.STARTUP, 0, wire.exception_text(exc)))
         os._exit(4)
     _write_all(fd_out, wire.pack_answer(-1, wire.READY, 0, json.dumps(layers)))
     while True:

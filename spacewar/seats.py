@@ -136,7 +136,7 @@ class InlineSeat:
         except MemoryError:
             return codes.NOOP, ("memory", "MemoryError in act")
         except BaseException as exc:  # SystemExit, KeyboardInterrupt included: a bot's fault
-            return codes.NOOP, ("raised", _exception_text(exc))
+            return codes.NOOP, ("raised", wire.exception_text(exc))
         elapsed = time.perf_counter() - start
         if not self.bank.charge(elapsed):
             return codes.NOOP, ("timeout", self.bank.late(elapsed))
@@ -145,7 +145,7 @@ class InlineSeat:
         except ValueError as exc:
             return codes.NOOP, ("invalid", f"returned {_short_repr(result)}: {exc}")
         except BaseException as exc:
-            return codes.NOOP, ("invalid", _exception_text(exc))
+            return codes.NOOP, ("invalid", wire.exception_text(exc))
 
     def close(self):
         return {"text": "", "bytes": 0, "truncated": False}
@@ -155,14 +155,6 @@ def printable(text):
     """``text`` with every control character (terminal escapes, newlines) shown escaped, so a
     bot's message cannot redraw the terminal it is printed on."""
     return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
-
-
-def _exception_text(exc):
-    try:
-        text = f"{type(exc).__name__}: {exc}"
-    except BaseException:
-        text = f"{type(exc).__name__} (its message could not be shown)"
-    return text[:wire.MAX_TEXT]
 
 
 def _bot_environment(scratch):

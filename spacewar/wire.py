@@ -77,6 +77,16 @@ def read_observe(read_exact):
 
 
 # -- bot -> match ---------------------------------------------------------------------------
+def exception_text(exc):
+    """``Kind: message`` of an exception, capped at ``MAX_TEXT``, even when its ``__str__``
+    misbehaves (a bot's exception is the bot's code)."""
+    try:
+        text = f"{type(exc).__name__}: {exc}"
+    except BaseException:
+        text = f"{type(exc).__name__} (its message could not be shown)"
+    return text[:MAX_TEXT]
+
+
 def pack_answer(frame, status, code=0, text=""):
     data = text.encode("utf-8", "replace")[:MAX_TEXT]
     return ANSWER_HEADER.pack(ANSWER_MAGIC, int(frame), int(status), int(code), len(data)) + data
