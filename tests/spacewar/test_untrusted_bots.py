@@ -435,3 +435,18 @@ def test_inline_bot_mutating_its_observation_changes_nothing(tmp_path):
     assert result["rules"] == SHORT.to_dict()
     ok, details = replay_io.check(rep)
     assert ok, details
+
+
+def test_a_tournament_of_hostile_bots_finishes_with_an_honest_table(capsys):
+    hostile = ["PickleBomb", "RawBytes", "EndlessLoop", "Forker", "Printer", "MemoryHog"]
+    bots = [f"{HOSTILE}:{b}" for b in hostile] + ["sniper"]
+    args = ["tournament", "--bots", ",".join(bots), "--games", "1", "--rounds", "1",
+            "--workers", "2", "--json", "--budget-ms", "50", "--overage-ms", "200",
+            "--bot-memory-mb", "512"]
+    assert main(args) == 0
+    report = json.loads(capsys.readouterr().out)  # stdout holds the report and nothing else
+    rows = {r["bot"]: r for r in report["table"]}
+    assert rows["sniper"]["wins"] == rows["sniper"]["played"] == 12
+    assert report["table"][0]["bot"] == "sniper"
+    for name in ("RawBytes", "EndlessLoop", "MemoryHog"):
+        assert rows[f"{HOSTILE}:{name}"]["forfeits"] >= 1
