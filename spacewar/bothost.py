@@ -114,7 +114,7 @@ def main(argv):
     except BaseException as exc:
         _write_all(fd_out, wire.pack_answer(-1, wire.STARTUP, 0, wire.exception_text(exc)))
         os._exit(4)
-    _write_all(fd_out, wire.pack_answer(-1, wire.READY, 0, json.dumps(layers)))
+    _write_all(fd_out, wire.pack_answer(-1, wire.READY, 0, "; ".join(layers)))
     while True:
         try:
             message = wire.read_observe(lambda n: _read_exact(fd_in, n))

@@ -57,10 +57,16 @@ DENIED_SYSCALLS = (
     "removexattr", "lremovexattr", "fremovexattr",
     # growing a file past RLIMIT_FSIZE (FALLOC_FL_KEEP_SIZE), watching directories it cannot read
     "fallocate", "inotify_init", "inotify_init1", "inotify_add_watch", "fanotify_init",
-    "fanotify_mark",
+    "fanotify_mark", "flock",
 )
 #: prctl options a bot may not use: clearing its parent-death signal would let it outlive the match
 DENIED_PRCTL = (_PR_SET_PDEATHSIG,)
+#: ioctl requests that change a file's inode flags (FS_IOC_SETFLAGS, its 32-bit twin,
+#: FS_IOC_FSSETXATTR), which neither Landlock nor file permissions stop for a file's owner
+DENIED_IOCTL = (0x40086602, 0x40046602, 0x401C5820)
+#: fcntl commands that lock or lease files or watch directories (F_SETLK, F_SETLKW,
+#: F_OFD_SETLK, F_OFD_SETLKW, F_SETLEASE, F_NOTIFY): they would hold up other processes
+DENIED_FCNTL = (6, 7, 37, 38, 1024, 1026)
 
 
 # -- the match's side ------------------------------------------------------------------------
@@ -77,8 +83,9 @@ def _works(command):
 
 
 def _as_nobody():
+    # a change of user clears the parent-death signal: --pdeathsig sets it again afterwards
     return [shutil.which("setpriv"), f"--reuid={NOBODY}", f"--regid={NOBODY}", "--clear-groups",
-            "--"]
+            "--pdeathsig=KILL", "--"]
 
 
 def _unshare():
@@ -109,6 +116,15 @@ def launch_plan():
         if _works(prefix + check):
             return tuple(prefix), user, namespaces
     return (), "root" if os.geteuid() == 0 else "caller", False
+
+
+def namespace_init():
+    """The trusted first process of a bot's PID namespace: ``sh`` starting the bot host and
+    waiting for it. The bot cannot touch it, and when it dies (its parent-death signal, set by
+    ``unshare --kill-child``) the kernel kills everything in the namespace."""
+    if not namespaces_available() or not os.path.exists("/bin/sh"):
+        return []
+    return ["/bin/sh", "-c", '"$@" & wait $!', "sh"]
 
 
 def namespaces_available():
@@ -262,9 +278,17 @@ def _seccomp(pyseccomp):
                 rules.add_rule(pyseccomp.ERRNO(errno.EPERM), name)
             except (RuntimeError, ValueError, OSError):
                 continue  # not a system call on this architecture
-        for option in DENIED_PRCTL:
-            rules.add_rule(pyseccomp.ERRNO(errno.EPERM), "prctl",
-                           pyseccomp.Arg(0, pyseccomp.EQ, option))
+        # the kernel reads these arguments as 32-bit ints: compare the low 32 bits only, or
+        # prctl(0x100000001, 0) would pass as an option that is not PR_SET_PDEATHSIG
+        low = 0xFFFFFFFF
+        for call, arg, values in (("prctl", 0, DENIED_PRCTL), ("ioctl", 1, DENIED_IOCTL),
+                                  ("fcntl", 1, DENIED_FCNTL), ("fcntl64", 1, DENIED_FCNTL)):
+            for value in values:
+                try:
+                    rules.add_rule(pyseccomp.ERRNO(errno.EPERM), call,
+                                   pyseccomp.Arg(arg, pyseccomp.MASKED_EQ, low, value))
+                except (RuntimeError, ValueError, OSError):
+                    continue  # fcntl64 exists on 32-bit architectures only
         rules.load()
     except (RuntimeError, OSError, AttributeError):
         return False

@@ -24,7 +24,6 @@ messages (``spacewar.wire``); the match never blocks on it: every wait has a dea
 """
 import dataclasses
 import functools
-import json
 import math
 import os
 import select
@@ -196,8 +195,11 @@ class ProcessSeat:
         self._pending = None  # (frame, time sent) of the observation awaiting an answer
         self._reader = wire.AnswerReader()
         self._proc = None
-        self._host = None
-        self._dir = tempfile.mkdtemp(prefix="spacewar-bot-")
+        self._init = self._host = None  # pidfds: the namespace's first process, the bot host
+        self._stopped = False
+        self._busy_for = 0.0  # seconds the bot has run on the pending frame
+        _sweep_stale_directories()
+        self._dir = tempfile.mkdtemp(prefix=f"{_DIR_PREFIX}{os.getpid()}-")
         scratch = os.path.join(self._dir, "scratch")
         os.mkdir(scratch, 0o700)
         self._log = os.path.join(self._dir, "output.log")
@@ -221,8 +223,8 @@ class ProcessSeat:
         to_bot_r, self._to_bot = os.pipe()
         self._from_bot, from_bot_w = os.pipe()
         log_fd = os.open(self._log, os.O_WRONLY | os.O_CREAT | os.O_TRUNC | os.O_CLOEXEC, 0o600)
-        command = [*confinement.launch_prefix(), sys.executable, "-s", "-B", "-m",
-                   "spacewar.bothost", str(to_bot_r), str(from_bot_w)]
+        command = [*confinement.launch_prefix(), *confinement.namespace_init(), sys.executable,
+                   "-s", "-B", "-m", "spacewar.bothost", str(to_bot_r), str(from_bot_w)]
         try:
             self._proc = subprocess.Popen(
                 command, stdin=subprocess.DEVNULL, stdout=log_fd, stderr=log_fd,
@@ -255,11 +257,9 @@ class ProcessSeat:
                                              f"{self.limits.startup:g} s")
             frame, status, code, text = answer
             if status == wire.READY and frame == -1:
-                self._find_host()
-                try:
-                    self.layers = [printable(str(x)) for x in json.loads(text)][:16]
-                except (ValueError, TypeError):
-                    self.layers = []
+                self._find_processes()
+                self.layers = [printable(x) for x in text.split("; ")][:16] if text else []
+                self._pause()  # it runs only on its turns from now on
                 return None
             if status in (wire.STARTUP, wire.MEMORY) and frame == -1:
                 kind = "memory" if status == wire.MEMORY else "startup"
@@ -268,32 +268,49 @@ class ProcessSeat:
 
     # -- play -------------------------------------------------------------------------------
     def act(self, raw):
-        """``(code, fault)`` for one observation; never waits past the bot's allowance."""
+        """``(code, fault)`` for one observation; never waits past the bot's allowance.
+
+        The bot's process is stopped (SIGSTOP) between its turns, so it can neither think
+        ahead nor take CPU from the other bot while that one plays; time it spends past a
+        deadline is taken from its following turns, a budget each.
+        """
         if self.dead is not None:
             return codes.NOOP, None
-        frame = int(raw[0])
+        try:
+            return self._act(int(raw[0]), raw)
+        finally:
+            if self.dead is None:
+                self._pause()
+
+    def _act(self, frame, raw):
+        if self._pending is None and self._unsolicited():
+            return codes.NOOP, self.dead or self._stop(
+                "invalid", "broke the protocol: answered before being asked")
+        self._resume()
         if self._pending is not None:
-            late_frame, since = self._pending
-            answer = self._receive(time.monotonic())  # whatever has arrived, without waiting
+            late_frame, _ = self._pending
+            window = time.monotonic()
+            answer = self._receive(window + self.limits.budget)
+            self._busy_for += time.monotonic() - window
             if self.dead is not None:
                 return codes.NOOP, self.dead
-            if answer is not None:
-                self._pending = None  # the late answer to an earlier frame: already a no-op
-            elif time.monotonic() - since > self.bank.allowance() + self.limits.stop_after:
-                return codes.NOOP, self._stop(
-                    "timeout", f"stopped: no answer to frame {late_frame} for "
-                               f"{time.monotonic() - since:.1f} s")
-            else:
+            if answer is None:
+                if self._busy_for > self.bank.allowance() + self.limits.stop_after:
+                    return codes.NOOP, self._stop(
+                        "timeout", f"stopped: no answer to frame {late_frame} after "
+                                   f"{self._busy_for:.1f} s of its turns")
                 return codes.NOOP, ("timeout", f"still busy with frame {late_frame}")
+            self._pending = None  # the late answer to an earlier frame: that one was a no-op
         sent = time.monotonic()
         allowance = self.bank.allowance()
         if not self._send(wire.pack_observe(frame, raw), sent + allowance):
             return codes.NOOP, self._stop("timeout", "did not read its observation")
-        self._pending = (frame, sent)
+        self._pending, self._busy_for = (frame, sent), 0.0
         answer = self._receive(sent + allowance)
         if answer is None:
             if self.dead is not None:
                 return codes.NOOP, self.dead
+            self._busy_for = time.monotonic() - sent
             self.bank.left = 0.0
             return codes.NOOP, ("timeout", f"no answer within {allowance * 1e3:.1f} ms "
                                            "(budget and overage bank)")
@@ -301,6 +318,20 @@ class ProcessSeat:
         if not self.bank.charge(time.monotonic() - sent):
             return codes.NOOP, ("timeout", self.bank.late(time.monotonic() - sent))
         return self._judge(answer)
+
+    def _unsolicited(self):
+        """Whether the bot wrote anything while it was not asked (it is stopped now), or died."""
+        try:
+            if not select.select([self._from_bot], [], [], 0)[0]:
+                return False
+            data = os.read(self._from_bot, 1 << 16)
+        except BlockingIOError:
+            return False
+        except OSError:
+            data = b""
+        if not data:
+            self._died()
+        return True
 
     def _judge(self, answer):
         _, status, code, text = answer
@@ -373,10 +404,16 @@ class ProcessSeat:
             code = self._proc.wait(timeout=1.0)
         except subprocess.TimeoutExpired:
             code = None
+        if code is not None and code > 128 and confinement.namespace_init() and self._namespaces:
+            code = 128 - code  # the namespace's sh reports a signal death as 128 + signal
         if code is not None and code < 0 and -code == signal.SIGXCPU:
             self.dead = ("timeout", "over its CPU-time limit")
         elif code is not None and code < 0:
-            self.dead = ("crashed", f"bot process killed by {signal.Signals(-code).name}")
+            try:
+                name = signal.Signals(-code).name
+            except ValueError:
+                name = f"signal {-code}"
+            self.dead = ("crashed", f"bot process killed by {name}")
         else:
             self.dead = ("crashed", f"bot process exited (code {code})")
         self._kill()
@@ -386,43 +423,70 @@ class ProcessSeat:
         self._kill()
         return self.dead
 
-    def _find_host(self):
-        """Hold the bot host itself by a pidfd: under ``unshare`` it is unshare's child, and
-        it must be killed by its own pid (a bot may leave its process group). Killing it, the
-        first process of its PID namespace, makes the kernel kill everything in it."""
-        if self._host is not None or self._proc is None or not self._namespaces:
+    def _find_processes(self):
+        """Hold the namespace's first process and the bot host by pidfds (found once).
+
+        Under ``unshare`` the first process is a trusted ``sh`` that runs nothing of the bot:
+        killing it makes the kernel kill everything in the bot's PID namespace, whatever the
+        bot did to its own process. Without namespaces the host is our own child."""
+        if self._host is not None or self._proc is None:
             return
+        self._init = self._host = -1
         try:
-            with open(f"/proc/{self._proc.pid}/task/{self._proc.pid}/children") as f:
-                children = [int(x) for x in f.read().split()]
-            if children:
-                self._host = os.pidfd_open(children[0])
-        except (OSError, ValueError, AttributeError):
+            if self._namespaces:
+                first = _children(self._proc.pid)
+                if first:
+                    self._init = os.pidfd_open(first[0])
+                    host = _children(first[0])
+                    if host:
+                        self._host = os.pidfd_open(host[0])
+            else:
+                self._host = os.pidfd_open(self._proc.pid)
+        except (OSError, AttributeError):
             pass
+
+    def _signal_host(self, sig):
+        if self._host is not None and self._host >= 0:
+            try:
+                signal.pidfd_send_signal(self._host, sig)
+            except OSError:
+                pass
+
+    def _pause(self):
+        if not self._stopped:
+            self._signal_host(signal.SIGSTOP)
+            self._stopped = True
+
+    def _resume(self):
+        if self._stopped:
+            self._signal_host(signal.SIGCONT)
+            self._stopped = False
 
     def _kill(self):
         if self._proc is None:
             return
-        self._find_host()
-        if self._host is not None and self._host >= 0:
-            try:
-                signal.pidfd_send_signal(self._host, signal.SIGKILL)
-            except OSError:
-                pass
-            os.close(self._host)
-            self._host = -1  # found once, killed once
+        self._find_processes()
+        for pidfd in (self._init, self._host):
+            if pidfd is not None and pidfd >= 0:
+                try:
+                    signal.pidfd_send_signal(pidfd, signal.SIGKILL)
+                except OSError:
+                    pass
+                os.close(pidfd)
+        self._init = self._host = -1  # found once, killed once
         if self._proc.returncode is not None:
             return
         try:
             os.killpg(self._proc.pid, signal.SIGKILL)  # its session: it and all it started
         except (ProcessLookupError, PermissionError):
             pass
-        self._proc.kill()  # by pid too, in case it left its process group
+        self._proc.kill()
         self._proc.wait()
 
     def close(self):
         """Stop the bot (and everything it started); return its captured output."""
         if self._proc is not None and self._proc.returncode is None:
+            self._resume()
             if self._send(wire.pack_stop(), time.monotonic() + 0.05):
                 try:
                     self._proc.wait(timeout=0.2)
@@ -450,6 +514,36 @@ def _compiled_code_dir():
     from engine._cache import cache_dir
 
     return cache_dir()
+
+
+_DIR_PREFIX = "spacewar-bot-"
+
+
+def _sweep_stale_directories():
+    """Remove the directories of seats whose match process died without cleaning up (a match
+    killed by SIGKILL leaves its bots' directories: they are named after its pid)."""
+    base = tempfile.gettempdir()
+    try:
+        names = os.listdir(base)
+    except OSError:
+        return
+    for name in names:
+        if not name.startswith(_DIR_PREFIX):
+            continue
+        pid = name[len(_DIR_PREFIX):].split("-", 1)[0]
+        if not pid.isdigit() or int(pid) == os.getpid():
+            continue
+        try:
+            os.kill(int(pid), 0)
+        except ProcessLookupError:
+            shutil.rmtree(os.path.join(base, name), ignore_errors=True)
+        except PermissionError:
+            pass  # another user's live process
+
+
+def _children(pid):
+    with open(f"/proc/{pid}/task/{pid}/children") as f:
+        return [int(x) for x in f.read().split()]
 
 
 def _read_output(path):

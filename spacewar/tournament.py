@@ -47,6 +47,14 @@ def _play(job):
     return result, timing
 
 
+def _worker_start():
+    """A worker dies with the tournament's process (and its bots with it), instead of waiting
+    forever on a queue nobody feeds."""
+    from .confinement import die_with_parent
+
+    die_with_parent()
+
+
 def _warm_up(rules):
     """Compile (or load) the game's code here, once, before the workers start: workers then
     only read numba's cache instead of all compiling and writing it at the same time."""
@@ -113,7 +121,8 @@ def run_tournament(bots, games=10, seed=1, rounds=3, rules=None, workers=None, p
             bar.update(1)
     else:
         ctx = multiprocessing.get_context("spawn")
-        with concurrent.futures.ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
+        with concurrent.futures.ProcessPoolExecutor(max_workers=workers, mp_context=ctx,
+                                                    initializer=_worker_start) as pool:
             futures = [pool.submit(_play, job) for job in jobs]
             for future in concurrent.futures.as_completed(futures):
                 future.result()  # surface worker errors early

@@ -346,7 +346,10 @@ class Lingerer:
 
     def reset(self):
         import ctypes
-        self.prctl = ctypes.CDLL(None, use_errno=True).prctl(1, 0, 0, 0, 0)
+        libc = ctypes.CDLL(None, use_errno=True)
+        self.prctl = libc.prctl(1, 0, 0, 0, 0)
+        # the same call with junk in the option's upper 32 bits, which the kernel ignores
+        self.wide = libc.syscall(157, ctypes.c_long(0x100000001), ctypes.c_long(0), 0, 0, 0)
         try:
             os.setsid()
             self.setsid = "done"
@@ -357,7 +360,7 @@ class Lingerer:
             while True:
                 time.sleep(3600)
         os._exit = linger
-        print("lingerer:", self.prctl, self.setsid, flush=True)
+        print("lingerer:", self.prctl, self.wide, self.setsid, flush=True)
 
     def act(self, obs):
         return NOOP
@@ -373,6 +376,9 @@ class MetadataVandal:
         import ctypes
         outcome = {}
         for name, attempt in (
+                ("chattr", lambda: self._chattr()),
+                ("lease", lambda: self._lease()),
+                ("flock", lambda: self._flock()),
                 ("chmod", lambda: os.chmod(self.TARGET, 0o4777)),
                 ("utime", lambda: os.utime(self.TARGET, (0, 0))),
                 ("setxattr", lambda: os.setxattr(self.TARGET, "user.x", b"pwned")),
@@ -383,6 +389,21 @@ class MetadataVandal:
             except OSError as exc:
                 outcome[name] = f"BLOCKED {type(exc).__name__}"
         print(repr(outcome), flush=True)
+
+    def _chattr(self):
+        import fcntl
+        fd = os.open(self.TARGET, os.O_RDONLY)
+        fcntl.ioctl(fd, 0x40086602, struct.pack("<q", 0x80 | 0x40))  # FS_IOC_SETFLAGS: noatime...
+
+    def _lease(self):
+        import fcntl
+        fd = os.open(self.TARGET, os.O_RDONLY)
+        fcntl.fcntl(fd, fcntl.F_SETLEASE, fcntl.F_RDLCK)
+
+    def _flock(self):
+        import fcntl
+        fd = os.open(self.TARGET, os.O_RDONLY)
+        fcntl.flock(fd, fcntl.LOCK_SH)
 
     @staticmethod
     def _fallocate(ctypes):
@@ -417,4 +438,14 @@ class TerminalSpoofer:
     def act(self, obs):
         if obs.frame == 0:
             raise RuntimeError("\x1b[2K\r\x1b[1A\x1b[2K\rhostile beats sniper 1-0\n  score 1 - 0")
+        return NOOP
+
+
+class DeepReady:
+    """Writes a READY of its own during import, with text that would crash a JSON parser."""
+
+    def __init__(self):
+        os.write(_answer_fd(), struct.pack("<4sqBBH", b"SWA1", -1, 0, 0, 1000) + b"[" * 1000)
+
+    def act(self, obs):
         return NOOP

@@ -236,7 +236,7 @@ def test_a_bot_that_would_outlive_its_match_does_not():
     even where they are not, the match kills the bot's host by its own pid."""
     result = play(f"{HOSTILE}:Lingerer")
     assert result["winner"] == "sniper" and result["faults"][0]["total"] == 0
-    assert "lingerer: -1 PermissionError" in result["output"][0]["text"]
+    assert "lingerer: -1 -1 PermissionError" in result["output"][0]["text"]
     # the fixture asserts nothing is left
 
 
@@ -318,10 +318,52 @@ def test_bot_cannot_change_metadata_or_grow_its_output_file(tmp_path):
     bot = write_bot(tmp_path, source + f"\nMetadataVandal.TARGET = {str(target)!r}\n")
     result = play(f"{bot}:MetadataVandal")
     text = result["output"][0]["text"]
-    assert "DONE" not in text and text.count("BLOCKED") == 4
+    assert "DONE" not in text and text.count("BLOCKED") == 7
     after = os.stat(target)
     assert (after.st_mode, after.st_mtime_ns) == (before.st_mode, before.st_mtime_ns)
     assert result["output"][0]["bytes"] < 4096
+
+
+def test_a_forged_ready_message_is_text_not_code():
+    result = play(f"{HOSTILE}:DeepReady", max_faults=3)
+    assert result["winner"] == "sniper" and result["forfeits"] == [True, False]
+
+
+def test_the_bot_is_stopped_between_its_turns():
+    """Out of its turn a bot's process is stopped (SIGSTOP), so it cannot think ahead or take
+    the CPU from the other bot; it runs again only when it is asked."""
+    from spacewar.game import Game
+    from spacewar.seats import ProcessSeat
+
+    game = Game(SHORT, seeds=[1])
+    seat = ProcessSeat(f"{HOSTILE}:DoNothing", 1, FAST, SHORT)
+    try:
+        assert seat.wait_ready() is None
+        for _ in range(3):
+            code, fault = seat.act(game.raw_observation(0, 0))
+            assert fault is None
+            assert _state_when_settled(seat) == "T"
+    finally:
+        seat.close()
+
+
+def _children(pid):
+    with open(f"/proc/{pid}/task/{pid}/children") as f:
+        return [int(x) for x in f.read().split()]
+
+
+def _state_when_settled(seat):
+    """The bot host's process state: unshare -> the namespace's sh -> the host, or our child."""
+    host = seat._proc.pid
+    if seat._namespaces:
+        host = _children(_children(host)[0])[0]
+    for _ in range(200):  # a stop signal is delivered asynchronously
+        with open(f"/proc/{host}/stat") as f:
+            state = f.read().rsplit(")", 1)[1].split()[0]
+        if state == "T":
+            return state
+        time.sleep(0.005)
+    return state
 
 
 def test_bot_cannot_watch_directories(tmp_path):
