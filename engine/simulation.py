@@ -20,6 +20,9 @@ from .units import UnitSystem, strip_without_units
 _MAX_STEPS = MAX_STEPS
 
 
+MAX_CAPACITY = 2 ** 31  # initial room beyond this is a mistake, not a plan (16 GiB of positions)
+
+
 class Simulation:
     """A set of particles moved by declared force terms with a chosen integrator.
 
@@ -31,7 +34,7 @@ class Simulation:
     tolerance : error tolerance of ``rk45`` (relative and absolute), > 0
     units : ``None`` (code units, G = 1) or three astropy units of length, time and mass
     G : override the gravitational constant (default 1, or astropy's G in ``units``)
-    capacity : initial room for particles (an int >= 0; grows as needed)
+    capacity : initial room for particles (an int in [0, 2**31]; grows as needed)
 
     ``pos``, ``vel``, ``mass``, ``charge`` and ``radius`` are writable views of the state. A
     step first checks them: a non-finite value written there (or a negative mass or radius)
@@ -53,8 +56,8 @@ class Simulation:
             self._G = nonnegative_float("G", G)
         if isinstance(capacity, (bool, np.bool_)) or not isinstance(capacity, numbers.Integral):
             raise TypeError(f"capacity must be an int >= 0, got {capacity!r}")
-        if capacity < 0:
-            raise ValueError(f"capacity must be an int >= 0, got {capacity!r}")
+        if not 0 <= capacity <= MAX_CAPACITY:
+            raise ValueError(f"capacity must be an int in [0, {MAX_CAPACITY}], got {capacity!r}")
         self.dim = int(dim)
         self._particles = Particles(self.dim, int(capacity))
         self._forces = []

@@ -106,6 +106,10 @@ def main(argv):
                                             "confinement failed: " + wire.exception_text(exc)))
         os._exit(3)
     _capture_output(int(config["output_bytes"]))
+    import warnings
+
+    # numba's cache cannot take its lock without /dev/shm: say nothing of it in the bot's output
+    warnings.filterwarnings("ignore", message="Could not obtain multiprocessing lock")
     try:
         bot, rules = _load(config)
     except MemoryError:

@@ -239,6 +239,9 @@ def _cmd_replay(args):
         if ok:
             print(f"OK: {args.file} replays identically: score {r['score'][0]}-{r['score'][1]}, "
                   f"{r['rounds']} rounds, {r['steps']} frames, final state {r['final_state_sha256'][:16]}")
+            if details.get("unchecked"):
+                print(f"  not re-derivable from a replay, so not compared: "
+                      f"{', '.join(details['unchecked'])}")
             return 0
         print(f"MISMATCH: {args.file}: {json.dumps(details['mismatches'], sort_keys=True)}")
         return 1

@@ -155,6 +155,8 @@ def die_with_parent():
 def confine(config):
     """Apply every layer this machine has, in the order each needs; return their names.
 
+    A layer the machine offers but that cannot be applied (Landlock refused, a seccomp filter
+    that does not load) raises: the bot then does not start, rather than start less confined.
     ``config`` keys: ``scratch`` (directory), ``scratch_mb``, ``memory_mb``, ``cpu_seconds``,
     ``max_files``, ``file_mb``, ``read_dirs``, ``read_files``, ``list_dirs``,
     ``namespaces`` (whether the launcher gave namespaces).
@@ -181,18 +183,17 @@ def confine(config):
     if libc is not None:
         signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # an over-long write fails, not the bot
         _drop_bounding_set(libc)
-        try:
-            from . import landlock
+        from . import landlock
 
+        if landlock.abi_version() >= 1:  # offered by the kernel: it must hold, or no bot runs
             abi = landlock.restrict(read_dirs=config["read_dirs"],
                                     read_files=config["read_files"],
                                     list_dirs=config["list_dirs"],
                                     write_dirs=[config["scratch"]],
                                     write_files=["/dev/null"])
             layers.append(f"landlock abi {abi}")
-        except OSError:
-            pass
-        if seccomp is not None and _seccomp(seccomp):
+        if seccomp is not None:
+            _seccomp(seccomp)  # libseccomp is here: its filter must load, or no bot runs
             layers.append("seccomp")
         if _drop_capabilities(libc):
             layers.append("no capabilities")
@@ -271,6 +272,7 @@ def _load_seccomp():
 
 
 def _seccomp(pyseccomp):
+    """Load the filter; raises OSError if it cannot be loaded."""
     try:
         rules = pyseccomp.SyscallFilter(pyseccomp.ALLOW)
         for name in DENIED_SYSCALLS:
@@ -290,9 +292,8 @@ def _seccomp(pyseccomp):
                 except (RuntimeError, ValueError, OSError):
                     continue  # fcntl64 exists on 32-bit architectures only
         rules.load()
-    except (RuntimeError, OSError, AttributeError):
-        return False
-    return True
+    except (RuntimeError, AttributeError) as exc:
+        raise OSError(f"the seccomp filter could not be loaded: {exc}") from exc
 
 
 def read_paths(extra_dirs=(), extra_files=()):

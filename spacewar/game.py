@@ -189,7 +189,16 @@ class Game:
         (``spacewar.protocol.raw_layout`` names its entries); written into ``out`` if given."""
         if not 0 <= m < self.n_matches or seat not in (0, 1):
             raise ValueError(f"no seat {seat!r} of match {m!r} in {self.n_matches} matches")
-        raw = np.empty(raw_length(self.rules)) if out is None else out
+        n = raw_length(self.rules)
+        if out is None:
+            raw = np.empty(n)
+        elif (not isinstance(out, np.ndarray) or out.dtype != np.float64 or out.shape != (n,)
+              or not out.flags.c_contiguous or not out.flags.writeable):
+            raise ValueError(f"out must be a writeable C-contiguous float64 array of shape ({n},), "
+                             f"got {type(out).__name__} "
+                             f"{getattr(out, 'dtype', '')} {getattr(out, 'shape', '')}")
+        else:
+            raw = out
         core.write_observation(int(m), int(seat), self.pos, self.vel, self.charge, self.active,
                                self.ship_f, self.ship_i, self.torp_life, self.mi, self.rp, raw)
         return raw

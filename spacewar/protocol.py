@@ -134,12 +134,12 @@ class Observation:
     rules: object = field(repr=False)
     _vector: np.ndarray = field(repr=False, default=None)
     _raw: np.ndarray = field(repr=False, default=None, compare=False)
-    _decode_rules: object = field(repr=False, default=None, compare=False)
+    _scales: tuple = field(repr=False, default=None, compare=False)
 
     def vector(self):
         """A flat float64 vector of fixed length (see ``vector_layout``), for learning code."""
         if self._vector is None and self._raw is not None:  # made on first use only
-            object.__setattr__(self, "_vector", _vector_from_raw(self._raw, self._decode_rules))
+            object.__setattr__(self, "_vector", _vector_from_raw(self._raw, self._scales))
         return self._vector.copy()
 
 
@@ -198,11 +198,12 @@ def _ship_from_raw(r):
                 charge=x[13], flip_cooldown=int(x[14]))
 
 
-def _ship_vector(x, rules):
+def _ship_vector(x, scales):
     """One ship's part of ``Observation.vector()`` from its raw numbers (a list)."""
-    return [x[0], x[1], x[2], x[3], np.cos(x[4]), np.sin(x[4]), x[5], x[6] / max(rules.fuel, 1e-300),
-            x[7] / rules.torpedoes, x[8] / max(rules.hyperspace_jumps, 1), x[9], x[10],
-            x[11] / max(rules.reload, 1), float(np.sign(x[13])), x[14] / max(rules.flip_cooldown, 1)]
+    fuel, torpedoes, jumps, reload, flip = scales[:5]
+    return [x[0], x[1], x[2], x[3], np.cos(x[4]), np.sin(x[4]), x[5], x[6] / fuel,
+            x[7] / torpedoes, x[8] / jumps, x[9], x[10], x[11] / reload, float(np.sign(x[13])),
+            x[14] / flip]
 
 
 def observation_from_raw(raw, rules, shown_rules=None):
@@ -223,18 +224,26 @@ def observation_from_raw(raw, rules, shown_rules=None):
                        frame=int(h[0]), round_frame=int(h[1]), round=int(h[2]),
                        score=(int(h[3]), int(h[4])), seat=int(h[5]),
                        rules=rules if shown_rules is None else shown_rules,
-                       _raw=_frozen(raw.copy()), _decode_rules=rules)
+                       _raw=_frozen(raw.copy()), _scales=_scales(rules))
 
 
-def _vector_from_raw(raw, rules):
+def _scales(rules):
+    """The numbers of the rules that scale the learning vector: plain floats, so that an
+    observation holds no reference to the rules that decoded it."""
+    return (max(rules.fuel, 1e-300), float(rules.torpedoes), float(max(rules.hyperspace_jumps, 1)),
+            float(max(rules.reload, 1)), float(max(rules.flip_cooldown, 1)),
+            float(max(rules.torpedo_life, 1)), max(rules.star_mu, 1e-300),
+            float(rules.max_round_frames))
+
+
+def _vector_from_raw(raw, scales):
     """``Observation.vector()`` from the raw observation (see ``vector_layout``)."""
     numbers = raw[_NH:_NH + 2 * _NS].tolist()
     slots = raw[_NH + 2 * _NS:].reshape(-1, _NT)
     present = slots[:, 0] != 0.0
     vec_t = np.zeros((slots.shape[0], 7))
     vec_t[:, :6] = slots[:, :6]
-    vec_t[:, 6] = slots[:, 6] / max(rules.torpedo_life, 1)
+    vec_t[:, 6] = slots[:, 6] / scales[5]
     vec_t[~present] = 0.0
-    return np.concatenate((_ship_vector(numbers[:_NS], rules) + _ship_vector(numbers[_NS:], rules)
-                           + [raw[6] / max(rules.star_mu, 1e-300), raw[1] / rules.max_round_frames],
-                           vec_t.ravel()))
+    return np.concatenate((_ship_vector(numbers[:_NS], scales) + _ship_vector(numbers[_NS:], scales)
+                           + [raw[6] / scales[6], raw[1] / scales[7]], vec_t.ravel()))

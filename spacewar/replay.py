@@ -472,6 +472,10 @@ def _replay_match(replay):
                                 f"frame(s) after the game was over at frame {i}")
                 break
             game.step(row[None, :])
+        if not game.over[0]:
+            # a forfeit would explain it, but a version 1 file has nothing to verify one by
+            problems.append(f"the record stops at frame {int(game.frame[0])} before the match "
+                            "is over, and a version 1 replay cannot show that anyone forfeited")
         return game, None, None, problems
     limit = math.inf if replay.get("max_faults") is None else replay["max_faults"]
     startup = replay.get("startup") or [0, 0]
@@ -502,6 +506,9 @@ def _replay_match(replay):
             asked += 1
             for s in range(2):
                 code = int(rows[i, s])
+                if code and i < codes.shape[0] and int(codes[i, s]) != core.NOOP:
+                    problems.append(f"seat {s} has a fault at frame {i} but its recorded action "
+                                    f"is {int(codes[i, s])}, not the no-op a fault plays")
                 if code:
                     add(s, frame, code)
                 elif fatal[s] == i:
@@ -541,11 +548,8 @@ def _derive(replay, game, forfeits, logs):
     derived = {"bots": bots, "seed": replay["seed"], "rounds_asked": replay["rounds"],
                "rules": Rules.from_dict(replay["rules"]).to_dict(), "score": score,
                "rounds": game.rounds_played(0), "steps": int(game.frame[0]), "error": error}
-    if forfeits is None:  # version 1: the forfeit is taken as recorded (it cannot be derived)
-        recorded = replay["result"]
+    if forfeits is None:  # version 1: only a match played to its end can be verified
         forfeit_seat = None
-        if recorded.get("forfeit") is not None and recorded.get("winner_seat") in (0, 1):
-            forfeit_seat = 1 - recorded["winner_seat"]
     else:
         forfeit_seat = forfeits.index(True) if forfeits.count(True) == 1 else None
     if forfeit_seat is not None or (forfeits is not None and any(forfeits)):
@@ -598,7 +602,8 @@ def check(replay):
     ``output``) cannot be re-derived without the bots and are not (``details["unchecked"]``
     lists the result fields left uncompared). Frames recorded after the match was over (or
     after a forfeit), and a record that stops before the match ended, are mismatches too.
-    Version 1 replays (no fault record) are checked without the fault and forfeit comparisons.
+    Version 1 replays (no fault record) are checked without the fault comparisons, and only
+    when they run to the match's end (nothing in them could verify a forfeit).
     ``details["mismatches"]`` maps each differing field to ``{"recorded", "replayed"}``
     (``"record"`` lists inconsistencies of the frames themselves). A structurally invalid
     replay raises ReplayError.

@@ -42,6 +42,10 @@ _KIND_BY_STATUS = {wire.RAISED: "raised", wire.INVALID: "invalid", wire.MEMORY: 
 SHOWN_OUTPUT = 4096  # bytes of a bot's stdout and stderr kept in the result
 
 
+MAX_SECONDS = 3600.0  # no budget of a bot's is longer than an hour
+MAX_CPU_SECONDS = 1 << 30
+
+
 @dataclasses.dataclass(frozen=True)
 class Limits:
     """What a bot may spend. Times in seconds, sizes in MiB.
@@ -67,16 +71,21 @@ class Limits:
     def __post_init__(self):
         for name in ("budget", "overage", "startup", "stop_after"):
             value = getattr(self, name)
+            low = "0 <=" if name == "overage" else "0 <"
             if isinstance(value, bool) or not isinstance(value, (int, float)) \
-                    or not math.isfinite(value) or value < 0 or (value == 0 and name != "overage"):
-                raise ValueError(f"{name} must be a finite number of seconds > 0, got {value!r}")
-        for name in ("memory_mb", "scratch_mb", "file_mb", "max_files", "output_bytes"):
+                    or not math.isfinite(value) or value < 0 or (value == 0 and name != "overage") \
+                    or value > MAX_SECONDS:
+                raise ValueError(f"{name} must be a number of seconds with {low} {name} <= "
+                                 f"{MAX_SECONDS}, got {value!r}")
+        for name, high in (("memory_mb", 1 << 20), ("scratch_mb", 1 << 14), ("file_mb", 1 << 14),
+                           ("max_files", 1 << 16), ("output_bytes", 1 << 30)):
             value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-                raise ValueError(f"{name} must be an int >= 1, got {value!r}")
+            if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= high:
+                raise ValueError(f"{name} must be an int in [1, {high}], got {value!r}")
         if self.cpu_seconds is not None and (isinstance(self.cpu_seconds, bool) or not isinstance(
-                self.cpu_seconds, int) or self.cpu_seconds < 1):
-            raise ValueError(f"cpu_seconds must be an int >= 1 or None, got {self.cpu_seconds!r}")
+                self.cpu_seconds, int) or not 1 <= self.cpu_seconds <= MAX_CPU_SECONDS):
+            raise ValueError(f"cpu_seconds must be None or an int in [1, {MAX_CPU_SECONDS}], "
+                             f"got {self.cpu_seconds!r}")
 
 
 class _Bank:
@@ -116,15 +125,22 @@ class InlineSeat:
             raise ValueError(f"inline seats are for built-in bots only, got {spec!r}: "
                              "other bots run in their own process")
         self.spec = spec
-        self._rules = rules
+        self._rules = type(rules).from_dict(rules.to_dict())  # decodes; the bot never sees it
         self.rules = type(rules).from_dict(rules.to_dict())  # the bot may break only its own copy
-        self.bot = make_bot(spec, seed=seed) if bot is None else bot
         self.bank = _Bank(limits)
         self.dead = None
-        self.layers = ["in this process (built-in bot)"]
-        reset = getattr(self.bot, "reset", None)
-        if callable(reset):
-            reset()
+        self.layers = ["in this process (built-in bot or the caller's bot object)"]
+        self.bot = make_bot(spec, seed=seed) if bot is None else bot
+        try:
+            reset = getattr(self.bot, "reset", None)
+            if callable(reset):
+                reset()
+        except BaseException as exc:  # SystemExit from a bot object's reset is its fault
+            self.dead = ("startup", wire.exception_text(exc))
+
+    def wait_ready(self):
+        """None when the bot is ready, else its start-up fault (it starts in the constructor)."""
+        return self.dead
 
     def act(self, raw):
         """``(code, fault)``: fault is None or ``(kind, message)``."""
@@ -198,31 +214,44 @@ class ProcessSeat:
         self._init = self._host = None  # pidfds: the namespace's first process, the bot host
         self._stopped = False
         self._busy_for = 0.0  # seconds the bot has run on the pending frame
+        self._to_bot = self._from_bot = self._log_fd = -1
+        self._dir = None
+        self._started = time.monotonic()
+        _, self._user, self._namespaces = confinement.launch_plan()
+        read_dirs, list_dirs, search_path = _bot_files(spec)  # a bad spec raises here, first
+        try:
+            self._start(spec, seed, rules, cpu_seconds, read_dirs, list_dirs, search_path)
+        except OSError as exc:  # no process, no pipe, no room: this bot cannot start
+            self._stop("startup", f"could not start its process: {wire.exception_text(exc)}")
+
+    def _start(self, spec, seed, rules, cpu_seconds, read_dirs, list_dirs, search_path):
+        limits = self.limits
         _sweep_stale_directories()
         self._dir = tempfile.mkdtemp(prefix=f"{_DIR_PREFIX}{os.getpid()}-")
         scratch = os.path.join(self._dir, "scratch")
         os.mkdir(scratch, 0o700)
-        self._log = os.path.join(self._dir, "output.log")
-        read_dirs, list_dirs, search_path = _bot_files(spec)
+        log = os.path.join(self._dir, "output.log")
+        # the match reads the bot's output through its own descriptor: whatever the bot does
+        # to the path, the match reads the file it made
+        log_fd = os.open(log, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_CLOEXEC, 0o600)
+        self._log_fd = os.open(log, os.O_RDONLY | os.O_CLOEXEC | os.O_NOFOLLOW)
+        if confinement.bot_uid() is not None:  # the bot runs as nobody: only scratch is its
+            os.chmod(self._dir, 0o711)
+            os.chown(scratch, confinement.bot_uid(), confinement.bot_uid())
         dirs, files = confinement.read_paths(extra_dirs=read_dirs)
-        _, user, namespaces = confinement.launch_plan()
-        self._namespaces = namespaces
-        if confinement.bot_uid() is not None:  # the bot runs as nobody: its directories are its
-            for path in (self._dir, scratch):
-                os.chown(path, confinement.bot_uid(), confinement.bot_uid())
         config = {
-            "spec": absolute_spec(spec), "seed": int(seed), "rules": rules.to_dict(), "path": search_path,
-            "output_bytes": limits.output_bytes,
-            "confinement": {"numba_cache": _compiled_code_dir(),"scratch": scratch, "scratch_mb": limits.scratch_mb,
-                            "memory_mb": limits.memory_mb, "file_mb": limits.file_mb,
-                            "max_files": limits.max_files, "namespaces": namespaces,
-                            "user": user,
-                            "cpu_seconds": cpu_seconds or limits.cpu_seconds or 3600,
+            "spec": absolute_spec(spec), "seed": int(seed), "rules": rules.to_dict(),
+            "path": search_path, "output_bytes": limits.output_bytes,
+            "confinement": {"numba_cache": _compiled_code_dir(), "scratch": scratch,
+                            "scratch_mb": limits.scratch_mb, "memory_mb": limits.memory_mb,
+                            "file_mb": limits.file_mb, "max_files": limits.max_files,
+                            "namespaces": self._namespaces, "user": self._user,
+                            "cpu_seconds": min(cpu_seconds or limits.cpu_seconds or 3600,
+                                               MAX_CPU_SECONDS),
                             "read_dirs": dirs, "read_files": files, "list_dirs": list_dirs},
         }
         to_bot_r, self._to_bot = os.pipe()
         self._from_bot, from_bot_w = os.pipe()
-        log_fd = os.open(self._log, os.O_WRONLY | os.O_CREAT | os.O_TRUNC | os.O_CLOEXEC, 0o600)
         command = [*confinement.launch_prefix(), *confinement.namespace_init(), sys.executable,
                    "-s", "-B", "-m", "spacewar.bothost", str(to_bot_r), str(from_bot_w)]
         try:
@@ -304,7 +333,7 @@ class ProcessSeat:
         sent = time.monotonic()
         allowance = self.bank.allowance()
         if not self._send(wire.pack_observe(frame, raw), sent + allowance):
-            return codes.NOOP, self._stop("timeout", "did not read its observation")
+            return codes.NOOP, self.dead or self._stop("timeout", "did not read its observation")
         self._pending, self._busy_for = (frame, sent), 0.0
         answer = self._receive(sent + allowance)
         if answer is None:
@@ -429,8 +458,8 @@ class ProcessSeat:
         Under ``unshare`` the first process is a trusted ``sh`` that runs nothing of the bot:
         killing it makes the kernel kill everything in the bot's PID namespace, whatever the
         bot did to its own process. Without namespaces the host is our own child."""
-        if self._host is not None or self._proc is None:
-            return
+        if self._host is not None or self._proc is None or self._proc.poll() is not None:
+            return  # found already, or never started, or gone (its pid may be another's now)
         self._init = self._host = -1
         try:
             if self._namespaces:
@@ -493,19 +522,28 @@ class ProcessSeat:
                 except subprocess.TimeoutExpired:
                     pass
             self._kill()
-        for fd in (self._to_bot, self._from_bot):
-            try:
-                os.close(fd)
-            except OSError:
-                pass
-        self._to_bot = self._from_bot = -1
-        output = _read_output(self._log)
-        shutil.rmtree(self._dir, ignore_errors=True)
+        output = _read_output(self._log_fd)
+        for fd in (self._to_bot, self._from_bot, self._log_fd):
+            if fd >= 0:
+                try:
+                    os.close(fd)
+                except OSError:
+                    pass
+        self._to_bot = self._from_bot = self._log_fd = -1
+        if self._dir is not None:
+            shutil.rmtree(self._dir, ignore_errors=True)
         return output
 
     def __del__(self):
         if getattr(self, "_proc", None) is not None and self._proc.returncode is None:
             self._kill()
+        for fd in (getattr(self, "_to_bot", -1), getattr(self, "_from_bot", -1),
+                   getattr(self, "_log_fd", -1)):
+            if fd >= 0:
+                try:
+                    os.close(fd)
+                except OSError:
+                    pass
 
 
 @functools.lru_cache(maxsize=None)
@@ -546,11 +584,13 @@ def _children(pid):
         return [int(x) for x in f.read().split()]
 
 
-def _read_output(path):
+def _read_output(fd):
+    """The first ``SHOWN_OUTPUT`` bytes of the bot's output file, its size, whether cut."""
+    if fd < 0:
+        return {"text": "", "bytes": 0, "truncated": False}
     try:
-        with open(path, "rb") as f:
-            head = f.read(SHOWN_OUTPUT + 1)
-            size = os.fstat(f.fileno()).st_size
+        head = os.pread(fd, SHOWN_OUTPUT + 1, 0)
+        size = os.fstat(fd).st_size
     except OSError:
         return {"text": "", "bytes": 0, "truncated": False}
     return {"text": head[:SHOWN_OUTPUT].decode("utf-8", "replace"), "bytes": int(size),

