@@ -58,12 +58,17 @@ DENIED_SYSCALLS = (
     # growing a file past RLIMIT_FSIZE (FALLOC_FL_KEEP_SIZE), watching directories it cannot read
     "fallocate", "inotify_init", "inotify_init1", "inotify_add_watch", "fanotify_init",
     "fanotify_mark", "flock",
+    # System V IPC: detached shared memory escapes RLIMIT_AS
+    "shmget", "shmat", "shmdt", "shmctl", "msgget", "msgsnd", "msgrcv", "msgctl", "semget",
+    "semop", "semtimedop", "semctl", "ipc",
 )
 #: prctl options a bot may not use: clearing its parent-death signal would let it outlive the match
 DENIED_PRCTL = (_PR_SET_PDEATHSIG,)
-#: ioctl requests that change a file's inode flags (FS_IOC_SETFLAGS, its 32-bit twin,
-#: FS_IOC_FSSETXATTR), which neither Landlock nor file permissions stop for a file's owner
-DENIED_IOCTL = (0x40086602, 0x40046602, 0x401C5820)
+#: ioctl types (the request's second byte) refused whole: the file-system ioctls ('f': inode
+#: flags, fs-verity, encryption policies; 'v': inode versions; 'X': FS_IOC_FSSETXATTR, freeze;
+#: 0x94: clone and dedupe ranges), which neither Landlock nor permissions stop for a file's
+#: owner; a terminal's 'T' ioctls (isatty) stay allowed
+DENIED_IOCTL_TYPES = (0x66, 0x76, 0x58, 0x94)
 #: fcntl commands that lock or lease files or watch directories (F_SETLK, F_SETLKW,
 #: F_OFD_SETLK, F_OFD_SETLKW, F_SETLEASE, F_NOTIFY): they would hold up other processes
 DENIED_FCNTL = (6, 7, 37, 38, 1024, 1026)
@@ -283,14 +288,15 @@ def _seccomp(pyseccomp):
         # the kernel reads these arguments as 32-bit ints: compare the low 32 bits only, or
         # prctl(0x100000001, 0) would pass as an option that is not PR_SET_PDEATHSIG
         low = 0xFFFFFFFF
-        for call, arg, values in (("prctl", 0, DENIED_PRCTL), ("ioctl", 1, DENIED_IOCTL),
-                                  ("fcntl", 1, DENIED_FCNTL), ("fcntl64", 1, DENIED_FCNTL)):
-            for value in values:
-                try:
-                    rules.add_rule(pyseccomp.ERRNO(errno.EPERM), call,
-                                   pyseccomp.Arg(arg, pyseccomp.MASKED_EQ, low, value))
-                except (RuntimeError, ValueError, OSError):
-                    continue  # fcntl64 exists on 32-bit architectures only
+        denied = [("prctl", 0, low, v) for v in DENIED_PRCTL]
+        denied += [("ioctl", 1, 0xFF00, t << 8) for t in DENIED_IOCTL_TYPES]
+        denied += [(call, 1, low, v) for call in ("fcntl", "fcntl64") for v in DENIED_FCNTL]
+        for call, arg, mask, value in denied:
+            try:
+                rules.add_rule(pyseccomp.ERRNO(errno.EPERM), call,
+                               pyseccomp.Arg(arg, pyseccomp.MASKED_EQ, mask, value))
+            except (RuntimeError, ValueError, OSError):
+                continue  # fcntl64 exists on 32-bit architectures only
         rules.load()
     except (RuntimeError, AttributeError) as exc:
         raise OSError(f"the seccomp filter could not be loaded: {exc}") from exc
@@ -304,10 +310,13 @@ def read_paths(extra_dirs=(), extra_files=()):
 
     import numpy
 
-    dirs = {sys.base_prefix, sys.prefix, sys.exec_prefix,
-            os.path.dirname(os.path.realpath(sys.executable)),
-            os.path.dirname(os.path.abspath(__file__)),
-            os.path.dirname(os.path.dirname(numpy.__file__))}
+    # the interpreter's own library directories, not its whole prefix (for a system Python
+    # that would be all of /usr), and the executable itself
+    dirs = {os.path.join(prefix, lib) for prefix in {sys.base_prefix, sys.exec_prefix}
+            for lib in ("lib", "lib64")}
+    dirs |= {sys.prefix, os.path.dirname(os.path.abspath(__file__)),
+             os.path.dirname(os.path.dirname(numpy.__file__))}
+    extra_files = (os.path.realpath(sys.executable), *extra_files)
     for key in ("stdlib", "platstdlib", "purelib", "platlib"):
         dirs.add(sysconfig.get_paths()[key])
     try:

@@ -312,7 +312,7 @@ class ProcessSeat:
                 self._pause()
 
     def _act(self, frame, raw):
-        if self._pending is None and self._unsolicited():
+        if self._pending is None and (self._reader.buffer or self._unsolicited()):
             return codes.NOOP, self.dead or self._stop(
                 "invalid", "broke the protocol: answered before being asked")
         self._resume()

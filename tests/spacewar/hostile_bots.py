@@ -377,6 +377,7 @@ class MetadataVandal:
         outcome = {}
         for name, attempt in (
                 ("chattr", lambda: self._chattr()),
+                ("setversion", lambda: self._setversion()),
                 ("lease", lambda: self._lease()),
                 ("flock", lambda: self._flock()),
                 ("chmod", lambda: os.chmod(self.TARGET, 0o4777)),
@@ -394,6 +395,11 @@ class MetadataVandal:
         import fcntl
         fd = os.open(self.TARGET, os.O_RDONLY)
         fcntl.ioctl(fd, 0x40086602, struct.pack("<q", 0x80 | 0x40))  # FS_IOC_SETFLAGS: noatime...
+
+    def _setversion(self):
+        import fcntl
+        fd = os.open(self.TARGET, os.O_RDONLY)
+        fcntl.ioctl(fd, 0x40087602, struct.pack("<q", 12345))  # FS_IOC_SETVERSION
 
     def _lease(self):
         import fcntl
@@ -446,6 +452,34 @@ class DeepReady:
 
     def __init__(self):
         os.write(_answer_fd(), struct.pack("<4sqBBH", b"SWA1", -1, 0, 0, 1000) + b"[" * 1000)
+
+    def act(self, obs):
+        return NOOP
+
+
+class PreAnswer:
+    """Takes over its host's answering and sends the next frame's answer with each one."""
+
+    def __init__(self):
+        host = sys.modules["__main__"]
+        original = host._answer
+
+        def double(bot, rules, frame, raw):
+            return original(bot, rules, frame, raw) + host.wire.pack_answer(frame + 1, 1, 2)
+        host._answer = double
+
+    def act(self, obs):
+        return NOOP
+
+
+class SharedMemoryHog:
+    """System V shared memory, which RLIMIT_AS does not count once detached."""
+
+    def reset(self):
+        import ctypes
+        libc = ctypes.CDLL(None, use_errno=True)
+        ident = libc.shmget(0, 8 << 20, 0o1000 | 0o600)
+        print("shm:", "GOT" if ident >= 0 else f"BLOCKED errno {ctypes.get_errno()}", flush=True)
 
     def act(self, obs):
         return NOOP

@@ -315,7 +315,7 @@ def test_bot_cannot_change_metadata_or_grow_its_output_file(tmp_path):
     bot = write_bot(tmp_path, source + f"\nMetadataVandal.TARGET = {str(target)!r}\n")
     result = play(f"{bot}:MetadataVandal")
     text = result["output"][0]["text"]
-    assert "DONE" not in text and text.count("BLOCKED") == 7
+    assert "DONE" not in text and text.count("BLOCKED") == 8
     after = os.stat(target)
     assert (after.st_mode, after.st_mtime_ns) == (before.st_mode, before.st_mtime_ns)
     assert result["output"][0]["bytes"] < 4096
@@ -541,3 +541,14 @@ def test_absurd_budgets_are_refused_before_any_bot_starts(capsys, option, value)
     assert main(["match", "--p1", "idle", "--p2", "idle", "--isolation", "process",
                  option, value]) == 2
     assert "must be a number of seconds" in capsys.readouterr().err
+
+
+def test_an_answer_sent_ahead_of_its_question_is_a_breach():
+    result = play(f"{HOSTILE}:PreAnswer", max_faults=1000)
+    assert result["forfeits"] == [True, False]
+    assert "answered before being asked" in result["faults"][0]["last"]["message"]
+
+
+def test_no_system_v_shared_memory():
+    result = play(f"{HOSTILE}:SharedMemoryHog")
+    assert "shm: BLOCKED errno 1" in result["output"][0]["text"]
