@@ -242,6 +242,13 @@ def _cmd_replay(args):
             if details.get("unchecked"):
                 print(f"  not re-derivable from a replay, so not compared: "
                       f"{', '.join(details['unchecked'])}")
+            if details.get("signature") == "verified":
+                print("  signed with this user's key: the bots and the fault record are as "
+                      "they were recorded")
+            else:
+                print(f"  WARNING: {details.get('signature')}: the bots' names and the fault "
+                      "record cannot be verified (only a replay signed with this user's key, "
+                      f"{replay_io.key_path()}, can vouch for them)")
             return 0
         print(f"MISMATCH: {args.file}: {json.dumps(details['mismatches'], sort_keys=True)}")
         return 1

@@ -24,9 +24,11 @@ the bots and are not compared.
 import base64
 import binascii
 import hashlib
+import hmac
 import json
 import math
 import os
+import secrets
 
 import numpy as np
 
@@ -146,8 +148,76 @@ def digest(replay):
     return hashlib.sha256(canonical_json(body).encode("ascii")).hexdigest()
 
 
+# -- signing ----------------------------------------------------------------------------------
+SIGNATURE_FIELD = "signature"
+
+
+def key_path():
+    """The file of this user's replay-signing key: ``$SPACEWAR_REPLAY_KEY_FILE``, else
+    ``$XDG_CONFIG_HOME/spacewar/replay-key`` (``~/.config``)."""
+    explicit = os.environ.get("SPACEWAR_REPLAY_KEY_FILE")
+    if explicit:
+        return explicit
+    base = os.environ.get("XDG_CONFIG_HOME") or os.path.join(os.path.expanduser("~"), ".config")
+    return os.path.join(base, "spacewar", "replay-key")
+
+
+def _key(create):
+    """This user's 32-byte signing key (made on first use, mode 0600), or None."""
+    path = key_path()
+    try:
+        with open(path) as f:
+            return bytes.fromhex(f.read().strip())
+    except FileNotFoundError:
+        if not create:
+            return None
+    except (OSError, ValueError) as exc:
+        raise ReplayError(f"the replay-signing key {path!r} is unreadable: {exc}") from None
+    os.makedirs(os.path.dirname(path) or ".", mode=0o700, exist_ok=True)
+    key = secrets.token_bytes(32)
+    try:
+        fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
+    except FileExistsError:  # made meanwhile by another process: use that one
+        return _key(create=False)
+    with os.fdopen(fd, "w") as f:
+        f.write(key.hex() + "\n")
+    return key
+
+
+def _key_id(key):
+    return hashlib.sha256(b"spacewar replay key " + key).hexdigest()[:16]
+
+
+def _mac(key, replay):
+    body = {k: v for k, v in replay.items() if k not in (DIGEST_FIELD, SIGNATURE_FIELD)}
+    return hmac.new(key, canonical_json(body).encode("ascii"), hashlib.sha256).hexdigest()
+
+
+def signature_status(replay):
+    """``"verified"`` (signed with this user's key and unchanged since), ``"unsigned"``,
+    ``"other key"`` (signed elsewhere: cannot be verified here) or ``"forged"``.
+
+    The content digest catches accidents, but anyone can recompute it; the signature is an
+    HMAC-SHA256 with a key only its owner has, so records the simulation cannot re-derive
+    (which bot sat where, the fault record) are trustworthy only when it verifies.
+    """
+    sig = replay.get(SIGNATURE_FIELD)
+    if sig is None:
+        return "unsigned"
+    if not isinstance(sig, dict) or not isinstance(sig.get("key"), str) \
+            or not isinstance(sig.get("hmac_sha256"), str):
+        return "forged"
+    key = _key(create=False)
+    if key is None or sig["key"] != _key_id(key):
+        return "other key"
+    return "verified" if hmac.compare_digest(sig["hmac_sha256"], _mac(key, replay)) else "forged"
+
+
 def save(path, replay):
-    """Check ``replay``, add its content digest and write it atomically to ``path``.
+    """Check ``replay``, sign it, add its content digest and write it atomically to ``path``.
+
+    The signature is an HMAC-SHA256 of the canonical content with this user's key
+    (``key_path()``, made on first use); see ``signature_status``.
 
     The path is checked first (``engine.atomic.check_output_path(path, "replay")``: an
     existing file there must be a replay or empty) and the file is written with
@@ -156,9 +226,15 @@ def save(path, replay):
     """
     if not isinstance(replay, dict):
         raise ReplayError(f"a replay must be a dict, got {type(replay).__name__}")
-    data = {k: v for k, v in replay.items() if k != DIGEST_FIELD}
+    data = {k: v for k, v in replay.items() if k not in (DIGEST_FIELD, SIGNATURE_FIELD)}
     data["version"] = data.get("version", VERSION)
     if data["version"] == VERSION:
+        path = check_output_path(path, "replay")  # before a key is made for it
+        key = _key(create=True)
+        try:
+            data[SIGNATURE_FIELD] = {"key": _key_id(key), "hmac_sha256": _mac(key, data)}
+        except (TypeError, ValueError) as exc:
+            raise ReplayError(f"replay to save is not plain JSON data: {exc}") from None
         data[DIGEST_FIELD] = digest(data)
     validate(data, "replay to save", require_digest=data["version"] >= 2)
     try:
@@ -604,6 +680,9 @@ def check(replay):
     after a forfeit), and a record that stops before the match ended, are mismatches too.
     Version 1 replays (no fault record) are checked without the fault comparisons, and only
     when they run to the match's end (nothing in them could verify a forfeit).
+    The bots' names and the fault record cannot be re-derived without the bots: they are
+    trusted when ``details["signature"]`` is ``"verified"`` (see ``signature_status``), and a
+    signature that does not match is a mismatch.
     ``details["mismatches"]`` maps each differing field to ``{"recorded", "replayed"}``
     (``"record"`` lists inconsistencies of the frames themselves). A structurally invalid
     replay raises ReplayError.
@@ -634,10 +713,14 @@ def check(replay):
     if problems:
         mismatches["record"] = {"recorded": replay["frames"], "replayed": got["steps"],
                                 "problems": problems}
+    signature = signature_status(replay)
+    if signature == "forged":
+        mismatches["signature"] = {"recorded": replay.get(SIGNATURE_FIELD),
+                                   "replayed": "does not match the content with this user's key"}
     return not mismatches, {"replayed": {**got, **derived}, "mismatches": mismatches,
-                            "unchecked": unchecked}
+                            "unchecked": unchecked, "signature": signature}
 
 
 __all__ = ["FORMAT", "VERSION", "FAULT_KINDS", "ReplayError", "make_replay", "save", "load",
            "validate", "check", "simulate", "actions", "fault_record", "digest",
-           "canonical_json"]
+           "canonical_json", "signature_status", "key_path", "SIGNATURE_FIELD"]

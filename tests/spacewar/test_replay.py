@@ -458,3 +458,41 @@ def test_a_faulted_frame_must_have_played_the_no_op():
     rep["actions"] = base64.b64encode(codes.astype("uint8").tobytes()).decode()
     ok, details = replay.check(rep)
     assert not ok and "not the no-op" in " ".join(details["mismatches"]["record"]["problems"])
+
+
+def test_signed_replays_detect_a_forger_who_recomputes_the_digest(tmp_path, replay_key):
+    """The content digest is public: anyone can recompute it. The signature is an HMAC with the
+    user's key: swapping the bots' names, or forging a fault record, is caught."""
+    import json as _json
+
+    from spacewar.match import play_match
+
+    result, rep, _ = play_match("idle", "sniper", seed=3, rounds=1, record=True)
+    path = tmp_path / "r.json"
+    replay.save(path, rep)
+    assert replay_key.exists() and (replay_key.stat().st_mode & 0o777) == 0o600
+    ok, details = replay.check(replay.load(path))
+    assert ok and details["signature"] == "verified"
+    data = _json.loads(path.read_text())
+    data["bots"] = data["result"]["bots"] = ["sniper", "idle"]  # idle "beats" sniper
+    data["result"]["winner"] = "idle"
+    data[replay.DIGEST_FIELD] = replay.digest(data)
+    path.write_text(_json.dumps(data))
+    ok, details = replay.check(replay.load(path))  # the digest is fine; the signature is not
+    assert not ok and details["signature"] == "forged" and "signature" in details["mismatches"]
+    del data[replay.SIGNATURE_FIELD]
+    data[replay.DIGEST_FIELD] = replay.digest(data)
+    assert replay.check(data)[1]["signature"] == "unsigned"
+
+
+def test_a_replay_signed_elsewhere_is_reported_as_unverifiable(tmp_path, monkeypatch, capsys):
+    from spacewar.cli import main
+    from spacewar.match import play_match
+
+    _, rep, _ = play_match("chaser", "random", seed=2, rounds=1, record=True)
+    path = tmp_path / "r.json"
+    replay.save(path, rep)
+    monkeypatch.setenv("SPACEWAR_REPLAY_KEY_FILE", str(tmp_path / "another-key"))
+    assert main(["replay", str(path), "--check"]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("OK") and "WARNING: other key" in out

@@ -1,0 +1,9 @@
+import pytest
+
+
+@pytest.fixture(autouse=True)
+def replay_key(tmp_path_factory, monkeypatch):
+    """Replays are signed with a key of the test run's own, never the user's."""
+    path = tmp_path_factory.getbasetemp() / "replay-key"
+    monkeypatch.setenv("SPACEWAR_REPLAY_KEY_FILE", str(path))
+    return path
