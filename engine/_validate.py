@@ -70,6 +70,16 @@ def real_array(name, value, what="numbers"):
     numpy infers is checked first: only integers and floats (or objects that are real numbers)
     pass.
     """
+    raw, kind = _numbers(name, value, what, "iuf", numbers.Real)
+    try:
+        return np.array(raw, dtype=np.float64)
+    except (TypeError, ValueError, OverflowError):
+        raise TypeError(f"{name} must be {what}, got {value!r}") from None
+
+
+def _numbers(name, value, what, kinds, number_type):
+    """``(raw, kind)``: ``value`` as an array whose dtype kind is in ``kinds``, or an object
+    array (kind "O") of ``number_type`` items; text and booleans are a TypeError."""
     if isinstance(value, _TEXT):
         raise TypeError(f"{name} must be {what}, got {value!r} (str)")
     try:
@@ -77,22 +87,26 @@ def real_array(name, value, what="numbers"):
     except (TypeError, ValueError):
         raise TypeError(f"{name} must be {what}, got {value!r}") from None
     kind = raw.dtype.kind
-    if isinstance(value, (list, tuple)) and kind in "iuf":
-        kind = "O"  # numpy reads (True, 0.0) as floats: look at the items themselves
+    if isinstance(value, (list, tuple)) and kind in kinds:
+        kind = "O"  # numpy reads (True, 0.0) as numbers: look at the items themselves
         raw = _items(value, raw)
     if kind == "O":
         for item in raw.reshape(-1):
-            if isinstance(item, _BOOLS) or not isinstance(item, numbers.Real):
+            if isinstance(item, _BOOLS) or not isinstance(item, number_type):
                 raise TypeError(f"{name} must be {what}, got {item!r} ({type(item).__name__}) "
                                 f"in {value!r}")
-    elif kind not in "iuf":
+    elif kind not in kinds:
         shown = raw.reshape(-1)[0].item() if raw.size else value
         raise TypeError(f"{name} must be {what}, got {shown!r} ({type(shown).__name__}) "
                         f"in {value!r}")
+    return raw, kind
+
+
+def _is_empty(value):
     try:
-        return np.array(raw, dtype=np.float64)
-    except (TypeError, ValueError, OverflowError):
-        raise TypeError(f"{name} must be {what}, got {value!r}") from None
+        return np.size(value) == 0
+    except (TypeError, ValueError):  # ragged: not empty, and _numbers will say what is wrong
+        return False
 
 
 def index_array(name, value, width=None):
@@ -103,29 +117,13 @@ def index_array(name, value, width=None):
     """
     shape = f"(M, {width})" if width else "a list of"
     what = f"{shape} integer particle indices"
-    if isinstance(value, _TEXT):
-        raise TypeError(f"{name} must be {what}, got {value!r} (str)")
-    try:
-        raw = np.asarray(value)
-    except (TypeError, ValueError):
-        raise TypeError(f"{name} must be {what}, got {value!r}") from None
-    if raw.size == 0:
-        raw = np.zeros((0, width) if width else 0, dtype=np.int64)
-    kind = raw.dtype.kind
-    if isinstance(value, (list, tuple)) and kind in "iu":
-        kind = "O"  # numpy reads (True, 2) as ints: look at the items themselves
-        raw = _items(value, raw)
+    if isinstance(value, (list, tuple, np.ndarray)) and _is_empty(value):
+        return np.zeros((0, width) if width else 0, dtype=np.int64)
+    raw, kind = _numbers(name, value, what, "iu", numbers.Integral)
     if kind == "O":
         for item in raw.reshape(-1):
-            if isinstance(item, _BOOLS) or not isinstance(item, numbers.Integral):
-                raise TypeError(f"{name} must be {what}, got {item!r} ({type(item).__name__}) "
-                                f"in {value!r}")
             if not -2 ** 63 <= item < 2 ** 63:
                 raise ValueError(f"{name} holds the index {item!r}, far out of any range")
-    elif kind not in "iu":
-        shown = raw.reshape(-1)[0].item()
-        raise TypeError(f"{name} must be {what}, got {shown!r} ({type(shown).__name__}) "
-                        f"in {value!r}")
     if kind == "u" and raw.size and int(raw.max()) >= 2 ** 63:
         raise ValueError(f"{name} holds the index {int(raw.max())!r}, far out of any range")
     return np.array(raw, dtype=np.int64)
