@@ -63,6 +63,9 @@ class Simulation:
         self._forces = []
         self._model = None
         self._model_key = None
+        # bumped by every add and remove of a force term: the packed model is keyed on it (a
+        # key of the terms' id() would match a removed term's reused address)
+        self._revision = 0
         self.t = 0.0
         self.steps = 0
 
@@ -247,6 +250,7 @@ class Simulation:
             raise ValueError(f"{force!r} is already declared in this simulation")
         force._attach(self)
         self._forces.append(force)
+        self._revision += 1
         return force
 
     def remove_force(self, force):
@@ -254,11 +258,12 @@ class Simulation:
             if f is force:
                 del self._forces[k]
                 force._sim = None
+                self._revision += 1
                 return
         raise ValueError(f"{force!r} is not declared in this simulation")
 
     def _current_model(self):
-        key = (self._G,) + tuple((id(f), f._version) for f in self._forces)
+        key = (self._G, self._revision) + tuple(f._version for f in self._forces)
         if key != self._model_key:
             self._model = pack(self._forces, self)
             self._model_key = key

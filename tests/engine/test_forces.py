@@ -362,3 +362,23 @@ def test_assignments_are_checked_before_anything_changes():
     gravity.box = None  # optional parameters take None
     gravity.precision = "float32"
     assert "precision='float32'" in repr(gravity)
+
+
+def test_a_removed_force_stops_acting_even_when_its_address_is_reused():
+    """The packed model was keyed on id() of the terms: CPython reuses a freed term's address,
+    so a new term could be mistaken for the removed one (issue #10's first item)."""
+    import numpy as _np
+
+    from engine import Simulation as _Simulation, forces as _forces
+
+    for _ in range(20):  # the address is reused often, not always
+        sim = _Simulation(dim=2, integrator="symplectic_euler", dt=0.1)
+        sim.add(mass=1.0, pos=(0, 0), vel=(1, 0))
+        d = _forces.Drag(linear=0.0)
+        sim.add_force(d)
+        sim.step()
+        sim.remove_force(d)
+        del d
+        sim.add_force(_forces.Drag(linear=5.0))
+        sim.step()
+        assert _np.allclose(sim.vel, [[0.5, 0.0]])
