@@ -13,6 +13,7 @@ import os
 import sys
 
 from . import wire
+from .protocol import observation_from_raw
 
 
 def _read_exact(fd, n):
@@ -74,21 +75,9 @@ def _load(config):
 
 
 def _answer(bot, rules, frame, raw):
-    from .protocol import action_code, observation_from_raw
-
-    obs = observation_from_raw(raw, rules)
-    try:
-        result = bot.act(obs)
-    except MemoryError:
-        return wire.pack_answer(frame, wire.MEMORY, 0, "MemoryError in act")
-    except BaseException as exc:  # SystemExit and KeyboardInterrupt from a bot are its faults
-        return wire.pack_answer(frame, wire.RAISED, 0, wire.exception_text(exc))
-    try:
-        return wire.pack_answer(frame, wire.OK, action_code(result))
-    except ValueError as exc:
-        return wire.pack_answer(frame, wire.INVALID, 0, f"returned an invalid answer: {exc}")
-    except BaseException as exc:
-        return wire.pack_answer(frame, wire.INVALID, 0, wire.exception_text(exc))
+    """The answer message of ``bot`` to the observation ``raw`` of ``frame``."""
+    status, code, text = wire.ask(bot, observation_from_raw(raw, rules))
+    return wire.pack_answer(frame, status, code, text)
 
 
 def main(argv):

@@ -145,10 +145,9 @@ def build_parser():
     return parser
 
 
-FAULT_KINDS = ("raised", "invalid", "timeout", "crashed", "startup", "memory")
-
-
 def _describe_match(result, timing):
+    from .seats import FAULT_KINDS
+
     p1, p2 = result["bots"]
     a, b = result["score"]
     if all(result.get("forfeits", [False, False])):

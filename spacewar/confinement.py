@@ -305,10 +305,20 @@ def _seccomp(pyseccomp):
 def read_paths(extra_dirs=(), extra_files=()):
     """What a bot may read: the interpreter and its libraries, the project's packages, the
     system's shared libraries, then the bot's own files (``extra_*``)."""
+    dirs, files = _installed_read_paths()
+    return (sorted(d for d in {*dirs, *extra_dirs} if d),
+            sorted({*files, *extra_files}))
+
+
+@functools.lru_cache(maxsize=None)
+def _installed_read_paths():
+    """The part of ``read_paths`` that is the same for every bot (found once)."""
     import site
     import sysconfig
 
     import numpy
+
+    import engine
 
     # the interpreter's own library directories, not its whole prefix (for a system Python
     # that would be all of /usr), and the executable itself
@@ -316,20 +326,17 @@ def read_paths(extra_dirs=(), extra_files=()):
             for lib in ("lib", "lib64")}
     dirs |= {sys.prefix, os.path.dirname(os.path.abspath(__file__)),
              os.path.dirname(os.path.dirname(numpy.__file__))}
-    extra_files = (os.path.realpath(sys.executable), *extra_files)
-    for key in ("stdlib", "platstdlib", "purelib", "platlib"):
-        dirs.add(sysconfig.get_paths()[key])
+    paths = sysconfig.get_paths()
+    dirs.update(paths[key] for key in ("stdlib", "platstdlib", "purelib", "platlib"))
     try:
         dirs.update(site.getsitepackages())
     except AttributeError:
         pass
-    import engine
-
     project = os.path.dirname(os.path.dirname(os.path.abspath(engine.__file__)))
     for package in ("engine", "spacewar", "validation"):  # the compiled-code cache hashes all three
         dirs.add(os.path.join(project, package))
     dirs.update(("/lib", "/lib64", "/usr/lib", "/usr/lib64", "/usr/local/lib",
                  "/sys/devices/system/cpu"))
-    dirs.update(extra_dirs)
-    files = {"/etc/ld.so.cache", "/dev/urandom", "/dev/random", "/dev/zero", *extra_files}
-    return sorted(d for d in dirs if d), sorted(files)
+    files = {os.path.realpath(sys.executable), "/etc/ld.so.cache", "/dev/urandom",
+             "/dev/random", "/dev/zero"}
+    return frozenset(dirs), frozenset(files)

@@ -203,12 +203,10 @@ class Game:
                                self.ship_f, self.ship_i, self.torp_life, self.mi, self.rp, raw)
         return raw
 
-    def observe(self, m, seat, rules=None):
+    def observe(self, m, seat):
         """The observation of match ``m`` from seat ``seat``'s side: a fresh object whose arrays
-        are read-only, so a bot cannot change the game through it. ``rules`` is the object
-        put in ``obs.rules`` (default: the game's own, frozen, rules)."""
-        return observation_from_raw(self.raw_observation(m, seat),
-                                    self.rules if rules is None else rules)
+        are read-only, so a bot cannot change the game through it."""
+        return observation_from_raw(self.raw_observation(m, seat), self.rules)
 
     def snapshot(self, m=0):
         """Plain data for drawing match ``m``: ships, torpedoes, score, frame."""

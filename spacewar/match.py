@@ -17,6 +17,7 @@ import numpy as np
 
 from . import core
 from .game import Game
+from .protocol import raw_length
 from .rules import Rules
 from .seats import FAULT_KINDS, Limits, bot_name, open_seat, printable
 
@@ -37,17 +38,15 @@ class FaultLog:
         self.counts = {kind: 0 for kind in FAULT_KINDS}
         self.examples = []
         self.last = None
+        self.total = 0
 
     def add(self, frame, kind, message):
         self.counts[kind] += 1
+        self.total += 1
         self.last = {"frame": int(frame), "kind": kind,
                      "message": printable(str(message))[:MAX_MESSAGE]}
         if len(self.examples) < 5:
             self.examples.append(self.last)
-
-    @property
-    def total(self):
-        return sum(self.counts.values())
 
     def to_dict(self):
         return {"total": self.total, **self.counts, "examples": self.examples, "last": self.last}
@@ -92,11 +91,12 @@ def play_match(p1, p2, seed=0, rounds=5, rules=None, budget=DEFAULT_BUDGET,
                 faults[s].add(0, *seat.dead)
                 forfeits[s] = True
         actions = np.full((1, 2), core.NOOP, dtype=np.int64)
+        raws = [np.empty(raw_length(rules)) for _ in seats]  # every seat copies what it keeps
         while not game.over[0] and not any(forfeits):
             frame = int(game.mi[0, core.FRAME])
             kinds = [0, 0]
             for s, seat in enumerate(seats):
-                code, fault = seat.act(game.raw_observation(0, s))
+                code, fault = seat.act(game.raw_observation(0, s, out=raws[s]))
                 actions[0, s] = code
                 if fault is not None:
                     faults[s].add(frame, *fault)

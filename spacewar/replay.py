@@ -37,13 +37,14 @@ from engine.atomic import atomic_write, check_output_path
 from . import core
 from .game import Game
 from .rules import Rules
+from .seats import FAULT_KINDS
 
 FORMAT = "spacewar-replay"
 VERSION = 2
 READABLE_VERSIONS = (1, 2)
 DIGEST_FIELD = "content_sha256"
-#: fault kinds in code order: code k (1..6) is FAULT_KINDS[k - 1]; 0 means no fault
-FAULT_KINDS = ("raised", "invalid", "timeout", "crashed", "startup", "memory")
+# fault kinds in code order (spacewar.seats.FAULT_KINDS): code k (1..6) is FAULT_KINDS[k - 1];
+# 0 means no fault
 MAX_FILE_BYTES = 64 * 1024 * 1024
 MAX_SEED = 2 ** 64 - 1
 MAX_ROUNDS = 2 ** 31 - 1

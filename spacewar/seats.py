@@ -35,7 +35,8 @@ import tempfile
 import time
 
 from . import codes, confinement, wire
-from .protocol import _short_repr, action_code, observation_from_raw
+from .bots import absolute_spec, is_builtin, locate, make_bot
+from .protocol import observation_from_raw
 
 FAULT_KINDS = ("raised", "invalid", "timeout", "crashed", "startup", "memory")
 _KIND_BY_STATUS = {wire.RAISED: "raised", wire.INVALID: "invalid", wire.MEMORY: "memory"}
@@ -119,8 +120,6 @@ class InlineSeat:
     cost it its turn; it sees a read-only observation and its own copy of the rules."""
 
     def __init__(self, spec, seed, limits, rules, bot=None):
-        from .bots import is_builtin, make_bot
-
         if bot is None and not is_builtin(spec):
             raise ValueError(f"inline seats are for built-in bots only, got {spec!r}: "
                              "other bots run in their own process")
@@ -146,21 +145,15 @@ class InlineSeat:
         """``(code, fault)``: fault is None or ``(kind, message)``."""
         obs = observation_from_raw(raw, self._rules, self.rules)
         start = time.perf_counter()
-        try:
-            result = self.bot.act(obs)
-        except MemoryError:
-            return codes.NOOP, ("memory", "MemoryError in act")
-        except BaseException as exc:  # SystemExit, KeyboardInterrupt included: a bot's fault
-            return codes.NOOP, ("raised", wire.exception_text(exc))
+        status, code, text = wire.ask(self.bot, obs)
         elapsed = time.perf_counter() - start
+        if status in (wire.RAISED, wire.MEMORY):  # no answer at all: its time is not charged
+            return codes.NOOP, (_KIND_BY_STATUS[status], text)
         if not self.bank.charge(elapsed):
             return codes.NOOP, ("timeout", self.bank.late(elapsed))
-        try:
-            return action_code(result), None
-        except ValueError as exc:
-            return codes.NOOP, ("invalid", f"returned {_short_repr(result)}: {exc}")
-        except BaseException as exc:
-            return codes.NOOP, ("invalid", wire.exception_text(exc))
+        if status == wire.INVALID:
+            return codes.NOOP, ("invalid", text)
+        return code, None
 
     def close(self):
         return {"text": "", "bytes": 0, "truncated": False}
@@ -185,18 +178,6 @@ def _bot_environment(scratch):
     return env
 
 
-def _bot_files(spec):
-    """``(read_dirs, list_dirs, search_path)`` the bot's own code needs, found without
-    running any of it."""
-    from .bots import locate
-
-    return locate(spec)
-
-
-def absolute_spec(spec):
-    from .bots import absolute_spec as absolute
-
-    return absolute(spec)
 
 
 class ProcessSeat:
@@ -218,7 +199,7 @@ class ProcessSeat:
         self._dir = None
         self._started = time.monotonic()
         _, self._user, self._namespaces = confinement.launch_plan()
-        read_dirs, list_dirs, search_path = _bot_files(spec)  # a bad spec raises here, first
+        read_dirs, list_dirs, search_path = locate(spec)  # a bad spec raises here, first
         try:
             self._start(spec, seed, rules, cpu_seconds, read_dirs, list_dirs, search_path)
         except OSError as exc:  # no process, no pipe, no room: this bot cannot start
@@ -610,7 +591,6 @@ def open_seat(spec, seed, limits=None, rules=None, isolation="auto", cpu_seconds
     string in its own confined process. ``isolation="process"`` puts built-in bots in a process
     too; ``inline`` is refused for a named bot that is not built in. A bot *object* (anything
     with ``act``) is the caller's own code and plays inline."""
-    from .bots import is_builtin, locate
     from .rules import Rules
 
     if isolation not in ("auto", "inline", "process"):

@@ -87,6 +87,29 @@ def exception_text(exc):
     return text[:MAX_TEXT]
 
 
+def ask(bot, obs):
+    """Ask ``bot`` for its action on ``obs``: ``(status, code, text)``, whatever it does.
+
+    Used on both sides of the wire: by a bot's process (``spacewar.bothost``) and by the
+    match for a bot it calls directly (``spacewar.seats.InlineSeat``). The code comes from the
+    answer's fields (``spacewar.protocol.action_code``), never from what its class says.
+    """
+    from .protocol import _short_repr, action_code
+
+    try:
+        result = bot.act(obs)
+    except MemoryError:
+        return MEMORY, 0, "MemoryError in act"
+    except BaseException as exc:  # SystemExit and KeyboardInterrupt from a bot are its faults
+        return RAISED, 0, exception_text(exc)
+    try:
+        return OK, action_code(result), ""
+    except ValueError as exc:
+        return INVALID, 0, f"returned {_short_repr(result)}: {exc}"
+    except BaseException as exc:
+        return INVALID, 0, exception_text(exc)
+
+
 def pack_answer(frame, status, code=0, text=""):
     data = text.encode("utf-8", "replace")[:MAX_TEXT]
     return ANSWER_HEADER.pack(ANSWER_MAGIC, int(frame), int(status), int(code), len(data)) + data

@@ -10,6 +10,19 @@ import time
 from spacewar import NOOP, Action
 
 
+def _report(success, attempts):
+    """Try each attempt; print ``{name: success word, or "BLOCKED <error>"}`` to stdout, which
+    the match captures into the result's ``output``."""
+    outcome = {}
+    for name, attempt in attempts.items():
+        try:
+            attempt()
+            outcome[name] = success
+        except OSError as exc:
+            outcome[name] = f"BLOCKED {type(exc).__name__}"
+    print(repr(outcome), flush=True)
+
+
 class DoNothing:
     """The honest baseline: plays the no-op every frame."""
 
@@ -300,20 +313,17 @@ class Networker:
 
     def reset(self):
         import socket
-        outcome = {}
-        for name, family, kind, address in (
-                ("tcp", socket.AF_INET, socket.SOCK_STREAM, ("127.0.0.1", self.PORT)),
-                ("udp", socket.AF_INET, socket.SOCK_DGRAM, ("127.0.0.1", self.PORT)),
-                ("unix", socket.AF_UNIX, socket.SOCK_STREAM, self.UNIX_PATH)):
-            try:
-                s = socket.socket(family, kind)
-                s.settimeout(1.0)
-                s.connect(address)
-                s.send(b"hello from the bot")
-                outcome[name] = "CONNECTED"
-            except OSError as exc:
-                outcome[name] = f"BLOCKED {type(exc).__name__}"
-        print(repr(outcome), flush=True)
+
+        def connect(family, kind, address):
+            s = socket.socket(family, kind)
+            s.settimeout(1.0)
+            s.connect(address)
+            s.send(b"hello from the bot")
+
+        _report("CONNECTED", {
+            "tcp": lambda: connect(socket.AF_INET, socket.SOCK_STREAM, ("127.0.0.1", self.PORT)),
+            "udp": lambda: connect(socket.AF_INET, socket.SOCK_DGRAM, ("127.0.0.1", self.PORT)),
+            "unix": lambda: connect(socket.AF_UNIX, socket.SOCK_STREAM, self.UNIX_PATH)})
 
     def act(self, obs):
         return NOOP
@@ -324,16 +334,14 @@ class Writer:
 
     def reset(self):
         import spacewar
-        outcome = {}
-        for path in (os.path.join(os.path.dirname(os.path.abspath(__file__)), "planted.txt"),
-                     os.path.join(os.path.dirname(spacewar.__file__), "planted.py"), "/tmp/planted"):
-            try:
-                with open(path, "w") as f:
-                    f.write("x")
-                outcome[path] = "WRITTEN"
-            except OSError as exc:
-                outcome[path] = f"BLOCKED {type(exc).__name__}"
-        print(repr(outcome), flush=True)
+
+        def write(path):
+            with open(path, "w") as f:
+                f.write("x")
+
+        paths = (os.path.join(os.path.dirname(os.path.abspath(__file__)), "planted.txt"),
+                 os.path.join(os.path.dirname(spacewar.__file__), "planted.py"), "/tmp/planted")
+        _report("WRITTEN", {path: (lambda p=path: write(p)) for path in paths})
 
     def act(self, obs):
         return NOOP
@@ -374,22 +382,12 @@ class MetadataVandal:
 
     def reset(self):
         import ctypes
-        outcome = {}
-        for name, attempt in (
-                ("chattr", lambda: self._chattr()),
-                ("setversion", lambda: self._setversion()),
-                ("lease", lambda: self._lease()),
-                ("flock", lambda: self._flock()),
-                ("chmod", lambda: os.chmod(self.TARGET, 0o4777)),
-                ("utime", lambda: os.utime(self.TARGET, (0, 0))),
-                ("setxattr", lambda: os.setxattr(self.TARGET, "user.x", b"pwned")),
-                ("fallocate", lambda: self._fallocate(ctypes))):
-            try:
-                attempt()
-                outcome[name] = "DONE"
-            except OSError as exc:
-                outcome[name] = f"BLOCKED {type(exc).__name__}"
-        print(repr(outcome), flush=True)
+        _report("DONE", {
+            "chattr": self._chattr, "setversion": self._setversion, "lease": self._lease,
+            "flock": self._flock, "chmod": lambda: os.chmod(self.TARGET, 0o4777),
+            "utime": lambda: os.utime(self.TARGET, (0, 0)),
+            "setxattr": lambda: os.setxattr(self.TARGET, "user.x", b"pwned"),
+            "fallocate": lambda: self._fallocate(ctypes)})
 
     def _chattr(self):
         import fcntl
