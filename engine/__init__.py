@@ -8,10 +8,11 @@
     sim.add_force(forces.UniformGravity(g=(0.0, -1.0)))
     sim.step(7)
 """
-from ._cache import project_cache
+from .cache import project_cache
 
-with project_cache():
-    from . import analytic, atomic, clock, diagnostics, forces, integrators
+with project_cache("engine"):
+    from . import analytic, atomic, cache, clock, diagnostics, forces, integrators, space, state
+    from .batch import Batch
     from .atomic import OutputPathError, atomic_write, check_output_dir, check_output_path
     from .clock import FixedStepClock
     from .errors import SimulationError
@@ -20,6 +21,6 @@ with project_cache():
 
 __version__ = "0.1.0"
 
-__all__ = ["Simulation", "SimulationError", "INTEGRATORS", "ORDERS", "SYMPLECTIC", "forces", "integrators",
+__all__ = ["Simulation", "Batch", "space", "state", "SimulationError", "INTEGRATORS", "ORDERS", "SYMPLECTIC", "forces", "integrators",
            "analytic", "clock", "diagnostics", "FixedStepClock", "__version__", "atomic",
            "atomic_write", "check_output_path", "check_output_dir", "OutputPathError"]

@@ -11,6 +11,8 @@ particles feel no force, exert none, do not move, and are left out of the diagno
 """
 import numpy as np
 
+from .state import State
+
 
 class Particles:
     """The particle arrays of one simulation (``n`` used slots out of ``capacity``)."""
@@ -30,6 +32,7 @@ class Particles:
             "radius": np.zeros(capacity),
             "active": np.zeros(capacity, dtype=np.bool_),
             "test": np.zeros(capacity, dtype=np.bool_),
+            "pinned": np.zeros(capacity, dtype=np.bool_),
         }
         for name, arr in fresh.items():
             if old_n:
@@ -44,7 +47,7 @@ class Particles:
         if need > self.capacity:
             self._allocate(max(need, 2 * self.capacity))
 
-    def append(self, pos, vel, mass, charge, radius, test):
+    def append(self, pos, vel, mass, charge, radius, test, pinned):
         """Append validated arrays of ``k`` particles; return their indices."""
         k = mass.shape[0]
         self.reserve(k)
@@ -55,10 +58,13 @@ class Particles:
         self.charge[s] = charge
         self.radius[s] = radius
         self.test[s] = test
+        self.pinned[s] = pinned
+        self.vel[:, s][:, pinned] = 0.0
         self.active[s] = True
         self.n += k
         return np.arange(s.start, s.stop)
 
-    def kernel_args(self):
-        """The per-particle arrays other than pos/vel, as the tuple the kernels take."""
-        return (self.mass, self.charge, self.radius, self.active, self.test)
+    def state(self, box):
+        """The arrays as the ``engine.state.State`` the kernels take (views of this storage)."""
+        return State(self.pos, self.vel, self.mass, self.charge, self.radius, self.active,
+                     self.test, self.pinned, self.n, box)

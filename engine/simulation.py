@@ -15,6 +15,7 @@ from .errors import SimulationError
 from .forces.base import Force
 from .forces.dispatch import pack, potential_terms
 from .particles import Particles
+from .space import check_box
 from .units import UnitSystem, strip_without_units
 
 _MAX_STEPS = MAX_STEPS
@@ -35,6 +36,9 @@ class Simulation:
     units : ``None`` (code units, G = 1) or three astropy units of length, time and mass
     G : override the gravitational constant (default 1, or astropy's G in ``units``)
     capacity : initial room for particles (an int in [0, 2**31]; grows as needed)
+    box : side L of a periodic space, the torus [-L/2, L/2)^dim (``None``: open space). The
+        drift wraps positions onto it and every pair force and collision takes separations
+        by the nearest image (``engine.space``).
 
     ``pos``, ``vel``, ``mass``, ``charge`` and ``radius`` are writable views of the state. A
     step first checks them: a non-finite value written there (or a negative mass or radius)
@@ -43,7 +47,7 @@ class Simulation:
     """
 
     def __init__(self, dim=2, integrator="symplectic_euler", dt=1.0, tolerance=1e-9,
-                 units=None, G=None, capacity=16):
+                 units=None, G=None, capacity=16, box=None):
         if isinstance(dim, bool) or dim not in (2, 3):
             raise ValueError(f"dim must be 2 or 3, got {dim!r}")
         self._units = None if units is None else UnitSystem(units)
@@ -58,6 +62,7 @@ class Simulation:
             raise TypeError(f"capacity must be an int >= 0, got {capacity!r}")
         if not 0 <= capacity <= MAX_CAPACITY:
             raise ValueError(f"capacity must be an int in [0, {MAX_CAPACITY}], got {capacity!r}")
+        self._box = check_box(self._code(box, "length", "box"))
         self.dim = int(dim)
         self._particles = Particles(self.dim, int(capacity))
         self._forces = []
@@ -107,6 +112,15 @@ class Simulation:
     @G.setter
     def G(self, value):
         self._G = nonnegative_float("G", self._code(value, "G", "G"))
+
+    @property
+    def box(self):
+        """Side of the periodic space (0.0 in open space)."""
+        return self._box
+
+    @box.setter
+    def box(self, value):
+        self._box = check_box(self._code(value, "length", "box"))
 
     @property
     def units(self):
@@ -167,15 +181,25 @@ class Simulation:
         view.flags.writeable = False
         return view
 
-    def add(self, mass=1.0, pos=None, vel=None, charge=0.0, radius=0.0, test=False):
-        """Add one particle; return its index. Quantities are converted when units are set."""
+    @property
+    def pinned(self):
+        """Read-only view of the pinned flags; change them with pin/unpin."""
+        view = self._particles.pinned[: self.n]
+        view.flags.writeable = False
+        return view
+
+    def add(self, mass=1.0, pos=None, vel=None, charge=0.0, radius=0.0, test=False, pinned=False):
+        """Add one particle; return its index. Quantities are converted when units are set.
+
+        ``pinned=True``: the particle stays where it is whatever acts on it (see ``pin``)."""
         return int(self.add_many(mass=[self._code(mass, "mass", "mass")],
                                  pos=None if pos is None else [self._code(pos, "length", "pos")],
                                  vel=None if vel is None else [self._code(vel, "velocity", "vel")],
                                  charge=[charge], radius=[self._code(radius, "length", "radius")],
-                                 test=[test], _single=True)[0])
+                                 test=[test], pinned=[pinned], _single=True)[0])
 
-    def add_many(self, mass, pos, vel=None, charge=0.0, radius=0.0, test=False, _single=False):
+    def add_many(self, mass, pos, vel=None, charge=0.0, radius=0.0, test=False, pinned=False,
+                 _single=False):
         """Add k particles from arrays (``pos``/``vel`` of shape (k, dim)); return their indices."""
         pos = self._code(pos, "length", "pos")
         vel = self._code(vel, "velocity", "vel")
@@ -191,13 +215,9 @@ class Simulation:
         m = self._column("mass", mass, k, minimum=0.0, single=_single)
         q = self._column("charge", charge, k, single=_single)
         r = self._column("radius", radius, k, minimum=0.0, single=_single)
-        try:
-            tst = np.broadcast_to(np.asarray(test), (k,))
-        except ValueError:
-            raise ValueError(f"test must be True or False (or one per particle), got {test!r}") from None
-        if tst.dtype != np.bool_:
-            raise TypeError(f"test must be True or False, got {test!r}")
-        return self._particles.append(p, v, m, q, r, tst)
+        tst = _flags("test", test, k)
+        pin = _flags("pinned", pinned, k)
+        return self._particles.append(p, v, m, q, r, tst, pin)
 
     def _rows(self, field, value, single):
         arr = real_array(field, value, "numbers")
@@ -215,13 +235,13 @@ class Simulation:
         arr = np.broadcast_to(arr, (k,)) if arr.ndim <= 1 else arr
         if arr.shape != (k,):
             raise ValueError(f"{field} must be a scalar or have length {k}, got shape {arr.shape}")
-        bad = ~np.isfinite(arr)
+        invalid = ~np.isfinite(arr)
         if minimum is not None:
-            bad |= arr < minimum
-        if np.any(bad):
-            val = arr[bad][0]
+            invalid |= arr < minimum
+        if np.any(invalid):
+            val = arr[invalid][0]
             rule = "finite" if minimum is None else f"finite and >= {minimum}"
-            where = "" if single else f" (particle {int(np.flatnonzero(bad)[0])} of the batch)"
+            where = "" if single else f" (particle {int(np.flatnonzero(invalid)[0])} of the batch)"
             raise ValueError(f"{field} must be {rule}, got {val!r}{where}")
         return arr
 
@@ -236,6 +256,22 @@ class Simulation:
 
     def activate(self, i):
         self._particles.active[self._index(i)] = True
+
+    def pin(self, i):
+        """Hold particle ``i`` where it is: its velocity becomes zero and no force moves it,
+        while it still exerts its own forces (a rope's anchor, a cloth's corner).
+
+        In the diagnostics a pinned particle is immovable, an external body like a
+        ``PointMass``: it has no kinetic energy and is left out of the momentum, the angular
+        momentum and the centre of mass; the potential energy keeps its interactions. So the
+        momentum of the rest is not conserved while it pulls on them (the pin holds it)."""
+        i = self._index(i)
+        self._particles.pinned[i] = True
+        self._particles.vel[:, i] = 0.0
+
+    def unpin(self, i):
+        """Let particle ``i`` move again (from rest)."""
+        self._particles.pinned[self._index(i)] = False
 
     # -- forces ----------------------------------------------------------------------
     @property
@@ -269,9 +305,28 @@ class Simulation:
             self._model_key = key
         return self._model
 
-    def _kernel_state(self):
-        p = self._particles
-        return p.pos, p.vel, p.kernel_args(), p.n, self._current_model()
+    def parameter(self, term, name):
+        """The packed values of ``term``'s float parameter ``name`` (a copy, shaped as the
+        term's ``LAYOUT`` declares: ``sim.parameter(star, "pos")`` is the attractor's
+        position), as the compiled kernels see them at the next step."""
+        model = self._current_model()
+        for k, f in enumerate(self._forces):
+            if f is term:
+                layout = term.layout(self)
+                if name not in layout:
+                    raise ValueError(f"{type(term).__name__} has no parameter {name!r}; its "
+                                     f"parameters are {', '.join(layout)}")
+                start, shape = layout[name]
+                start += int(model.foff[k])
+                size = int(np.prod(shape, dtype=np.int64))
+                return model.fp[start:start + size].reshape(shape).copy()
+        raise ValueError(f"{term!r} is not declared in this simulation")
+
+    def kernel_arguments(self):
+        """``(state, model)``: this simulation as the ``engine.state`` named tuples the compiled
+        kernels take (views of its arrays, and its packed force terms), for compiled code of
+        your own: ``engine.forces.dispatch.accelerations(sim.t, state, model, acc, work)``."""
+        return self._particles.state(self._box), self._current_model()
 
     # -- time ------------------------------------------------------------------------
     def step(self, n=1):
@@ -321,73 +376,84 @@ class Simulation:
         if self._integrator != "rk45" and not math.isfinite(self._t + steps * h):
             raise ValueError(f"{steps} steps of {h!r} from t={self._t!r} take the time past the "
                              "largest float (t would not be finite); nothing was changed")
-        pos, vel, prm, n, model = self._kernel_state()
-        self._check_state(pos, vel, prm, n)
+        state, model = self.kernel_arguments()
+        self._check_state(state)
         vdep = any(f.velocity_dependent for f in self._forces)
-        t, h_next, done, bad = _integrators.advance(
-            self._integrator, self._t, h, steps, pos, vel, prm, n, model, vdep, t_end,
-            self._tolerance)
+        t, h_next, done, status = _integrators.advance(
+            self._integrator, self._t, h, steps, state, model, vdep, t_end, self._tolerance)
         failed_step = self.steps + done
         self._t = t
         self.steps += done
-        if (self._integrator == "rk45" and not keep_dt and bad < 0
-                and bad != _integrators.common.TIME_OVERFLOW):
+        if (self._integrator == "rk45" and not keep_dt and status < 0
+                and status != _integrators.common.TIME_OVERFLOW):
             self._dt = h_next
-        if bad >= 0:
+        if status >= 0:
             raise SimulationError(
-                f"step {failed_step} from t={t!r} with {self._integrator} gave particle {bad} a "
+                f"step {failed_step} from t={t!r} with {self._integrator} gave particle {status} a "
                 "non-finite position or velocity (singular force, or dt too large for a stiff "
                 "force); the last finite state is kept",
-                step=failed_step, time=t, particle=int(bad))
-        if bad == _integrators.common.TIME_OVERFLOW:
+                step=failed_step, time=t, particle=int(status))
+        if status == _integrators.common.TIME_OVERFLOW:
             raise SimulationError(
                 f"rk45 step {failed_step} from t={t!r} with step {h_next!r} would take the time "
                 "past the largest float (t would not be finite); the last finite state is kept",
                 step=failed_step, time=t, particle=None)
-        if bad == _integrators.common.STEP_COLLAPSED:
+        if status == _integrators.common.STEP_COLLAPSED:
             raise SimulationError(
                 f"rk45 step size collapsed at step {failed_step}, t={t!r} (tolerance "
                 f"{self._tolerance!r} cannot be met); the last accepted state is kept",
                 step=failed_step, time=t, particle=None)
 
-    def _check_state(self, pos, vel, prm, n):
+    def _check_state(self, state):
         """Refuse to step from a state the user made invalid by writing the arrays directly.
 
         ``sim.pos``, ``vel``, ``mass``, ``charge`` and ``radius`` are writable views: a
         non-finite value written there is bad input of that field (ValueError naming it, state
-        unchanged), never reported as a numerical blow-up of the step.
+        unchanged), never reported as a numerical blow-up of the step. A pinned particle's
+        velocity written there is set back to zero (nothing moves it).
         """
+        pos, vel, n = state.pos, state.vel, state.n
+        pinned = state.pinned[:n]
+        if pinned.any():
+            vel[:, :n][:, pinned] = 0.0
         if not (np.isfinite(pos[:, :n]).all() and np.isfinite(vel[:, :n]).all()):
-            bad = np.flatnonzero(~(np.isfinite(pos[:, :n]).all(0) & np.isfinite(vel[:, :n]).all(0)))
-            i = int(bad[0])
+            broken = np.flatnonzero(~(np.isfinite(pos[:, :n]).all(0) & np.isfinite(vel[:, :n]).all(0)))
+            i = int(broken[0])
             field = "pos" if not np.isfinite(pos[:, i]).all() else "vel"
             raise ValueError(f"particle {i} has a non-finite pos or vel: {field}[{i}] = "
                              f"{(pos if field == 'pos' else vel)[:, i]} was written with a "
                              "non-finite value (bad input); nothing was changed")
-        mass, charge, radius = prm[0], prm[1], prm[2]
+        mass, charge, radius = state.mass, state.charge, state.radius
         for field, arr, minimum in (("mass", mass, 0.0), ("charge", charge, None),
                                     ("radius", radius, 0.0)):
             values = arr[:n]
-            bad = ~np.isfinite(values)
+            invalid = ~np.isfinite(values)
             if minimum is not None:
-                bad |= values < minimum
-            if bad.any():
-                i = int(np.flatnonzero(bad)[0])
+                invalid |= values < minimum
+            if invalid.any():
+                i = int(np.flatnonzero(invalid)[0])
                 rule = "finite" if minimum is None else f"finite and >= {minimum}"
+                hint = (" (to hold a particle still, pin it: sim.pin(i))"
+                        if field == "mass" and values[i] == math.inf else "")
                 raise ValueError(f"{field}[{i}] must be {rule}, got {float(values[i])!r} (written into "
                                  f"sim.{field} directly: bad input, not a blow-up); nothing was "
-                                 "changed")
+                                 f"changed{hint}")
 
     # -- diagnostics -----------------------------------------------------------------
+    def _moving(self):
+        """The particles the diagnostics count: active and not pinned."""
+        p = self._particles
+        return p.active & ~p.pinned
+
     def kinetic_energy(self):
         p = self._particles
-        return diagnostics.kinetic_energy(p.vel, p.mass, p.active, p.n)
+        return diagnostics.kinetic_energy(p.vel, p.mass, self._moving(), p.n)
 
     def potential_energy_terms(self):
         """Potential energy of each declared term, in declaration order."""
-        pos, vel, prm, n, model = self._kernel_state()
+        state, model = self.kernel_arguments()
         out = np.zeros(len(self._forces))
-        potential_terms(self._t, pos, vel, *prm, n, *model, out)
+        potential_terms(self._t, state, model, out)
         return out
 
     def potential_energy(self):
@@ -399,17 +465,17 @@ class Simulation:
 
     def momentum(self):
         p = self._particles
-        return diagnostics.momentum(p.vel, p.mass, p.active, p.n)
+        return diagnostics.momentum(p.vel, p.mass, self._moving(), p.n)
 
     def angular_momentum(self):
         """About the origin: a 3-vector in 3-D, the scalar L_z in 2-D."""
         p = self._particles
-        L = diagnostics.angular_momentum(p.pos, p.vel, p.mass, p.active, p.n)
+        L = diagnostics.angular_momentum(p.pos, p.vel, p.mass, self._moving(), p.n)
         return float(L[0]) if self.dim == 2 else L
 
     def center_of_mass(self):
         p = self._particles
-        return diagnostics.center_of_mass(p.pos, p.vel, p.mass, p.active, p.n)
+        return diagnostics.center_of_mass(p.pos, p.vel, p.mass, self._moving(), p.n)
 
     # -- units -----------------------------------------------------------------------
     def _code(self, value, kind, field):
@@ -428,6 +494,17 @@ class Simulation:
     def __repr__(self):
         return (f"Simulation(dim={self.dim}, integrator={self._integrator!r}, dt={self._dt!r}, "
                 f"n={self.n}, t={self._t!r}, forces={self._forces!r})")
+
+
+def _flags(field, value, k):
+    """``value`` as k booleans (one for all, or one per particle)."""
+    try:
+        flags = np.broadcast_to(np.asarray(value), (k,))
+    except ValueError:
+        raise ValueError(f"{field} must be True or False (or one per particle), got {value!r}") from None
+    if flags.dtype != np.bool_:
+        raise TypeError(f"{field} must be True or False, got {value!r}")
+    return flags
 
 
 __all__ = ["Simulation"]

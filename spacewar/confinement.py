@@ -205,15 +205,17 @@ def confine(config):
     return layers
 
 
-def _copy_compiled_code(source, scratch):
-    """A copy of the project's compiled code in the scratch directory (numba loads its cache
-    only from a writable directory), so a bot using the engine's kernels does not compile them."""
-    if not source or not os.path.isdir(source):
-        return
-    try:
-        shutil.copytree(source, os.path.join(scratch, "numba", os.path.basename(source)))
-    except OSError:
-        pass  # no room: the bot compiles what it uses
+def _copy_compiled_code(sources, scratch):
+    """A copy of the engine's and the game's compiled code in the scratch directory (numba
+    loads its cache only from a writable directory), so a bot using the engine's kernels does
+    not compile them."""
+    for source in sources or ():
+        if not os.path.isdir(source):
+            continue
+        try:
+            shutil.copytree(source, os.path.join(scratch, "numba", os.path.basename(source)))
+        except OSError:
+            pass  # no room: the bot compiles what it uses
 
 
 def _mount_scratch(libc, path, size_mb):
@@ -333,7 +335,7 @@ def _installed_read_paths():
     except AttributeError:
         pass
     project = os.path.dirname(os.path.dirname(os.path.abspath(engine.__file__)))
-    for package in ("engine", "spacewar", "validation"):  # the compiled-code cache hashes all three
+    for package in ("engine", "spacewar"):  # what the bot's host imports, and the cache hashes
         dirs.add(os.path.join(project, package))
     dirs.update(("/lib", "/lib64", "/usr/lib", "/usr/lib64", "/usr/local/lib",
                  "/sys/devices/system/cpu"))

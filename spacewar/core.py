@@ -8,8 +8,9 @@ engine's own ``symplectic_euler`` splitting kernel with the engine's force terms
 modes), so there is one physics, not two.
 
 Bodies per match: ships 0 and 1, then ``T`` torpedo slots for ship 0 and ``T`` for ship 1.
-Positions are wrapped onto the torus [-0.5, 0.5)^2 after each step; distances for collisions
-use the nearest image. Randomness (fuel burn, hyperspace) comes from a per-match splitmix64
+The matches are one ``engine.Batch`` (a system per match, the periodic space of side 1): the
+engine's drift wraps positions onto the torus [-0.5, 0.5)^2 and its pair forces and the
+collisions here take the nearest image, all with ``engine.space``'s one wrap. Randomness (fuel burn, hyperspace) comes from a per-match splitmix64
 stream, so a match is bit-identical for a given seed whatever else runs beside it.
 """
 import math
@@ -17,19 +18,22 @@ import math
 import numpy as np
 from numba import njit
 
+from engine import space
+from engine.batch import advance_system
 from engine.integrators import splitting
+from engine.state import Workspace
 
 # -- layout of the state arrays ---------------------------------------------------------
-# ship floats (M, 2, SF)
+# ship gauges, floats (M, 2, SF): heading, turn rate, fuel
 HEADING, OMEGA, FUEL, SF = 0, 1, 2, 3
-# ship ints (M, 2, SI)
+# ship counters and flags, ints (M, 2, SI)
 (TORPS, RELOAD, HYPER_LEFT, HYPER_TIMER, HYPER_RECHARGE, HYPER_JUMPS, FLIP_CD, ALIVE, IN_HYPER,
  FIRE_LATCH, THRUSTING, KILLED_AT, SI) = range(13)
-# match ints (M, MI)
+# match state, ints (M, MI): frame counters, scores, end timer, flags
 (FRAME, ROUND_FRAME, ROUNDS_PLAYED, END_TIMER, SCORE0, SCORE1, OVER, ERROR, ROUND_FRAMES_TOTAL,
  MI) = range(10)
 
-# rules vector (float64) indices
+# the rules as one float64 vector (``rules`` in the functions below): indices
 (R_TURN, R_ANG_ACCEL, R_ANG_MOM, R_THRUST, R_BURN_MIN, R_BURN_MAX, R_FUEL, R_SHIP_MASS,
  R_START, R_NTORP, R_RELOAD, R_TLIFE, R_MUZZLE, R_OFFSET, R_TMASS, R_HJUMPS, R_HFRAMES,
  R_HRECHARGE, R_HRISK, R_REENTRY, R_HITBOX, R_DIAMOND, R_DELAY, R_MAXFRAMES, R_ROUNDS,
@@ -60,25 +64,25 @@ def uniform(rng, m):
     return float(next_u64(rng, m) >> np.uint64(11)) * (1.0 / 9007199254740992.0)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def wrap(x):
-    """Onto the torus coordinate range [-0.5, 0.5)."""
-    return x - math.floor(x + 0.5)
+    """Onto the torus coordinate range [-0.5, 0.5): the engine's one wrap, side 1."""
+    return space.wrap_scalar(x, 1.0)
 
 
 @njit(cache=True)
-def ship_start(s, rp):
+def ship_start(s, rules):
     """Start position and heading: opposite corners of the star, each facing the other's side."""
-    d = rp[R_START] / math.sqrt(2.0)
+    d = rules[R_START] / math.sqrt(2.0)
     if s == 0:
         return -d, d, -0.5 * math.pi
     return d, -d, 0.5 * math.pi
 
 
 @njit(cache=True)
-def reset_round(m, pos, vel, mass, charge, active, ship_f, ship_i, torp_life, mi, rp):
+def reset_round(m, pos, vel, mass, charge, active, ship_gauges, ship_counters, torp_life, match_state, rules):
     """Ships back to their start, full stores, torpedoes cleared."""
-    ntorp = int(rp[R_NTORP])
+    ntorp = int(rules[R_NTORP])
     n = pos.shape[2]
     for b in range(n):
         active[m, b] = False
@@ -87,163 +91,163 @@ def reset_round(m, pos, vel, mass, charge, active, ship_f, ship_i, torp_life, mi
     for k in range(torp_life.shape[1]):
         torp_life[m, k] = 0
     for s in range(2):
-        x, y, h = ship_start(s, rp)
+        x, y, h = ship_start(s, rules)
         pos[m, 0, s] = x
         pos[m, 1, s] = y
         active[m, s] = True
-        mass[m, s] = rp[R_SHIP_MASS]
-        charge[m, s] = rp[R_CHARGE] * (1.0 if s == 0 else -1.0) if rp[R_ELECTRIC] > 0 else 0.0
-        ship_f[m, s, HEADING] = h
-        ship_f[m, s, OMEGA] = 0.0
-        ship_f[m, s, FUEL] = rp[R_FUEL]
-        ship_i[m, s, TORPS] = ntorp
-        ship_i[m, s, RELOAD] = 0
-        ship_i[m, s, HYPER_LEFT] = int(rp[R_HJUMPS])
-        ship_i[m, s, HYPER_TIMER] = 0
-        ship_i[m, s, HYPER_RECHARGE] = 0
-        ship_i[m, s, HYPER_JUMPS] = 0
-        ship_i[m, s, FLIP_CD] = 0
-        ship_i[m, s, ALIVE] = 1
-        ship_i[m, s, IN_HYPER] = 0
-        ship_i[m, s, FIRE_LATCH] = 0
-        ship_i[m, s, THRUSTING] = 0
-        ship_i[m, s, KILLED_AT] = -1
-    mi[m, ROUND_FRAME] = 0
-    mi[m, END_TIMER] = -1
+        mass[m, s] = rules[R_SHIP_MASS]
+        charge[m, s] = rules[R_CHARGE] * (1.0 if s == 0 else -1.0) if rules[R_ELECTRIC] > 0 else 0.0
+        ship_gauges[m, s, HEADING] = h
+        ship_gauges[m, s, OMEGA] = 0.0
+        ship_gauges[m, s, FUEL] = rules[R_FUEL]
+        ship_counters[m, s, TORPS] = ntorp
+        ship_counters[m, s, RELOAD] = 0
+        ship_counters[m, s, HYPER_LEFT] = int(rules[R_HJUMPS])
+        ship_counters[m, s, HYPER_TIMER] = 0
+        ship_counters[m, s, HYPER_RECHARGE] = 0
+        ship_counters[m, s, HYPER_JUMPS] = 0
+        ship_counters[m, s, FLIP_CD] = 0
+        ship_counters[m, s, ALIVE] = 1
+        ship_counters[m, s, IN_HYPER] = 0
+        ship_counters[m, s, FIRE_LATCH] = 0
+        ship_counters[m, s, THRUSTING] = 0
+        ship_counters[m, s, KILLED_AT] = -1
+    match_state[m, ROUND_FRAME] = 0
+    match_state[m, END_TIMER] = -1
 
 
 @njit(cache=True)
-def _kill_ship(m, s, active, ship_i, frame):
-    if ship_i[m, s, ALIVE] == 1:
-        ship_i[m, s, ALIVE] = 0
-        ship_i[m, s, KILLED_AT] = frame
-        ship_i[m, s, THRUSTING] = 0
+def _kill_ship(m, s, active, ship_counters, frame):
+    if ship_counters[m, s, ALIVE] == 1:
+        ship_counters[m, s, ALIVE] = 0
+        ship_counters[m, s, KILLED_AT] = frame
+        ship_counters[m, s, THRUSTING] = 0
         active[m, s] = False
 
 
 @njit(cache=True)
-def _fire(m, s, pos, vel, mass, charge, active, ship_f, ship_i, torp_life, rp):
-    ntorp = int(rp[R_NTORP])
-    k = ntorp - ship_i[m, s, TORPS]  # each torpedo of a round has its own slot
+def _fire(m, s, pos, vel, mass, charge, active, ship_gauges, ship_counters, torp_life, rules):
+    ntorp = int(rules[R_NTORP])
+    k = ntorp - ship_counters[m, s, TORPS]  # each torpedo of a round has its own slot
     b = 2 + s * ntorp + k
-    h = ship_f[m, s, HEADING]
+    h = ship_gauges[m, s, HEADING]
     c = math.cos(h)
     sn = math.sin(h)
-    pos[m, 0, b] = wrap(pos[m, 0, s] + rp[R_OFFSET] * c)
-    pos[m, 1, b] = wrap(pos[m, 1, s] + rp[R_OFFSET] * sn)
-    vel[m, 0, b] = vel[m, 0, s] + rp[R_MUZZLE] * c
-    vel[m, 1, b] = vel[m, 1, s] + rp[R_MUZZLE] * sn
-    mass[m, b] = rp[R_TMASS]
+    pos[m, 0, b] = wrap(pos[m, 0, s] + rules[R_OFFSET] * c)
+    pos[m, 1, b] = wrap(pos[m, 1, s] + rules[R_OFFSET] * sn)
+    vel[m, 0, b] = vel[m, 0, s] + rules[R_MUZZLE] * c
+    vel[m, 1, b] = vel[m, 1, s] + rules[R_MUZZLE] * sn
+    mass[m, b] = rules[R_TMASS]
     charge[m, b] = charge[m, s]
     active[m, b] = True
-    torp_life[m, s * ntorp + k] = int(rp[R_TLIFE])
-    ship_i[m, s, TORPS] -= 1
-    ship_i[m, s, RELOAD] = int(rp[R_RELOAD])
+    torp_life[m, s * ntorp + k] = int(rules[R_TLIFE])
+    ship_counters[m, s, TORPS] -= 1
+    ship_counters[m, s, RELOAD] = int(rules[R_RELOAD])
 
 
 @njit(cache=True)
-def _reenter(m, s, pos, vel, active, ship_f, ship_i, rng, rp):
+def _reenter(m, s, pos, vel, active, ship_gauges, ship_counters, rng, rules):
     """Back from hyperspace at a random place, speed and heading; jump k breaks up with k/8."""
-    ship_i[m, s, IN_HYPER] = 0
-    ship_i[m, s, HYPER_RECHARGE] = int(rp[R_HRECHARGE])
+    ship_counters[m, s, IN_HYPER] = 0
+    ship_counters[m, s, HYPER_RECHARGE] = int(rules[R_HRECHARGE])
     while True:  # not inside the star's reach
         x = uniform(rng, m) - 0.5
         y = uniform(rng, m) - 0.5
-        if rp[R_STAR] == 0.0 or x * x + y * y > (6.0 * rp[R_CAPTURE]) ** 2:
+        if rules[R_STAR] == 0.0 or x * x + y * y > (6.0 * rules[R_CAPTURE]) ** 2:
             break
-    speed = rp[R_REENTRY] * uniform(rng, m)
+    speed = rules[R_REENTRY] * uniform(rng, m)
     direction = 2.0 * math.pi * uniform(rng, m)
     pos[m, 0, s] = x
     pos[m, 1, s] = y
     vel[m, 0, s] = speed * math.cos(direction)
     vel[m, 1, s] = speed * math.sin(direction)
-    ship_f[m, s, HEADING] = 2.0 * math.pi * uniform(rng, m) - math.pi
-    ship_f[m, s, OMEGA] = 0.0
+    ship_gauges[m, s, HEADING] = 2.0 * math.pi * uniform(rng, m) - math.pi
+    ship_gauges[m, s, OMEGA] = 0.0
     active[m, s] = True
-    breakup = min(1.0, rp[R_HRISK] * ship_i[m, s, HYPER_JUMPS])
+    breakup = min(1.0, rules[R_HRISK] * ship_counters[m, s, HYPER_JUMPS])
     return uniform(rng, m) < breakup
 
 
 @njit(cache=True)
-def _control(m, s, code, frame, pos, vel, mass, charge, active, ship_f, ship_i, torp_life, fp,
-             rng, rp):
+def _control(m, s, code, frame, pos, vel, mass, charge, active, ship_gauges, ship_counters, torp_life, force_params,
+             rng, rules):
     """Apply one ship's action for this frame: turn, thrust, fire, hyperspace, polarity."""
     turn = code % 3 - 1
     thrust = (code // 3) % 2 == 1
     fire = (code // 6) % 2 == 1
     hyper = (code // 12) % 2 == 1
     flip = (code // 24) % 2 == 1
-    off = int(rp[R_THRUST_OFF])
-    fp[m, off + 2 * s] = 0.0
-    fp[m, off + 2 * s + 1] = 0.0
-    ship_i[m, s, THRUSTING] = 0
-    if ship_i[m, s, RELOAD] > 0:
-        ship_i[m, s, RELOAD] -= 1
-    if ship_i[m, s, HYPER_RECHARGE] > 0:
-        ship_i[m, s, HYPER_RECHARGE] -= 1
-    if ship_i[m, s, FLIP_CD] > 0:
-        ship_i[m, s, FLIP_CD] -= 1
-    if ship_i[m, s, ALIVE] == 0:
+    off = int(rules[R_THRUST_OFF])
+    force_params[m, off + 2 * s] = 0.0
+    force_params[m, off + 2 * s + 1] = 0.0
+    ship_counters[m, s, THRUSTING] = 0
+    if ship_counters[m, s, RELOAD] > 0:
+        ship_counters[m, s, RELOAD] -= 1
+    if ship_counters[m, s, HYPER_RECHARGE] > 0:
+        ship_counters[m, s, HYPER_RECHARGE] -= 1
+    if ship_counters[m, s, FLIP_CD] > 0:
+        ship_counters[m, s, FLIP_CD] -= 1
+    if ship_counters[m, s, ALIVE] == 0:
         return
-    if ship_i[m, s, IN_HYPER] == 1:
-        ship_i[m, s, HYPER_TIMER] -= 1
-        if ship_i[m, s, HYPER_TIMER] <= 0:
-            if _reenter(m, s, pos, vel, active, ship_f, ship_i, rng, rp):
-                _kill_ship(m, s, active, ship_i, frame)  # broke up in hyperspace
+    if ship_counters[m, s, IN_HYPER] == 1:
+        ship_counters[m, s, HYPER_TIMER] -= 1
+        if ship_counters[m, s, HYPER_TIMER] <= 0:
+            if _reenter(m, s, pos, vel, active, ship_gauges, ship_counters, rng, rules):
+                _kill_ship(m, s, active, ship_counters, frame)  # broke up in hyperspace
         return
-    if hyper and ship_i[m, s, HYPER_LEFT] > 0 and ship_i[m, s, HYPER_RECHARGE] == 0:
-        ship_i[m, s, HYPER_LEFT] -= 1
-        ship_i[m, s, HYPER_JUMPS] += 1
-        ship_i[m, s, IN_HYPER] = 1
-        ship_i[m, s, HYPER_TIMER] = int(rp[R_HFRAMES])
+    if hyper and ship_counters[m, s, HYPER_LEFT] > 0 and ship_counters[m, s, HYPER_RECHARGE] == 0:
+        ship_counters[m, s, HYPER_LEFT] -= 1
+        ship_counters[m, s, HYPER_JUMPS] += 1
+        ship_counters[m, s, IN_HYPER] = 1
+        ship_counters[m, s, HYPER_TIMER] = int(rules[R_HFRAMES])
         active[m, s] = False
         return
     # turning
-    if rp[R_ANG_MOM] > 0:
-        w = ship_f[m, s, OMEGA] + turn * rp[R_ANG_ACCEL]
-        limit = 4.0 * rp[R_TURN]
-        ship_f[m, s, OMEGA] = min(limit, max(-limit, w))
-        ship_f[m, s, HEADING] += ship_f[m, s, OMEGA]
+    if rules[R_ANG_MOM] > 0:
+        w = ship_gauges[m, s, OMEGA] + turn * rules[R_ANG_ACCEL]
+        limit = 4.0 * rules[R_TURN]
+        ship_gauges[m, s, OMEGA] = min(limit, max(-limit, w))
+        ship_gauges[m, s, HEADING] += ship_gauges[m, s, OMEGA]
     else:
-        ship_f[m, s, HEADING] += turn * rp[R_TURN]
-    h = ship_f[m, s, HEADING]
+        ship_gauges[m, s, HEADING] += turn * rules[R_TURN]
+    h = ship_gauges[m, s, HEADING]
     if h > math.pi:
-        ship_f[m, s, HEADING] = h - 2.0 * math.pi
+        ship_gauges[m, s, HEADING] = h - 2.0 * math.pi
     elif h <= -math.pi:
-        ship_f[m, s, HEADING] = h + 2.0 * math.pi
-    h = ship_f[m, s, HEADING]
+        ship_gauges[m, s, HEADING] = h + 2.0 * math.pi
+    h = ship_gauges[m, s, HEADING]
     # thrust: a control force through the engine's Thrust term
-    if thrust and ship_f[m, s, FUEL] > 0.0:
-        burn = rp[R_BURN_MIN] + (rp[R_BURN_MAX] - rp[R_BURN_MIN]) * uniform(rng, m)
-        ship_f[m, s, FUEL] = max(0.0, ship_f[m, s, FUEL] - burn)
-        f = rp[R_THRUST] * mass[m, s]
-        fp[m, off + 2 * s] = f * math.cos(h)
-        fp[m, off + 2 * s + 1] = f * math.sin(h)
-        ship_i[m, s, THRUSTING] = 1
+    if thrust and ship_gauges[m, s, FUEL] > 0.0:
+        burn = rules[R_BURN_MIN] + (rules[R_BURN_MAX] - rules[R_BURN_MIN]) * uniform(rng, m)
+        ship_gauges[m, s, FUEL] = max(0.0, ship_gauges[m, s, FUEL] - burn)
+        f = rules[R_THRUST] * mass[m, s]
+        force_params[m, off + 2 * s] = f * math.cos(h)
+        force_params[m, off + 2 * s + 1] = f * math.sin(h)
+        ship_counters[m, s, THRUSTING] = 1
     # polarity flip (electric mode)
-    if flip and rp[R_ELECTRIC] > 0 and ship_i[m, s, FLIP_CD] == 0:
+    if flip and rules[R_ELECTRIC] > 0 and ship_counters[m, s, FLIP_CD] == 0:
         charge[m, s] = -charge[m, s]
-        ship_i[m, s, FLIP_CD] = int(rp[R_FLIP_CD])
+        ship_counters[m, s, FLIP_CD] = int(rules[R_FLIP_CD])
     # fire
-    latched = rp[R_SINGLE] > 0 and ship_i[m, s, FIRE_LATCH] == 1
-    if fire and not latched and ship_i[m, s, TORPS] > 0 and ship_i[m, s, RELOAD] == 0:
-        _fire(m, s, pos, vel, mass, charge, active, ship_f, ship_i, torp_life, rp)
-    ship_i[m, s, FIRE_LATCH] = 1 if fire else 0
+    latched = rules[R_SINGLE] > 0 and ship_counters[m, s, FIRE_LATCH] == 1
+    if fire and not latched and ship_counters[m, s, TORPS] > 0 and ship_counters[m, s, RELOAD] == 0:
+        _fire(m, s, pos, vel, mass, charge, active, ship_gauges, ship_counters, torp_life, rules)
+    ship_counters[m, s, FIRE_LATCH] = 1 if fire else 0
 
 
 @njit(cache=True)
 def _hit(pos, m, a, b, box, diamond):
     """The original's diamond proximity test, by the nearest image on the torus."""
-    dx = abs(wrap(pos[m, 0, b] - pos[m, 0, a]))
-    dy = abs(wrap(pos[m, 1, b] - pos[m, 1, a]))
+    dx = abs(space.wrap_scalar(pos[m, 0, b] - pos[m, 0, a], 1.0))  # the nearest image
+    dy = abs(space.wrap_scalar(pos[m, 1, b] - pos[m, 1, a], 1.0))
     return dx < box and dy < box and dx + dy < diamond
 
 
 @njit(cache=True)
-def _collisions(m, pos, vel, active, ship_i, torp_life, mi, rp):
+def _collisions(m, pos, vel, active, ship_counters, torp_life, match_state, rules):
     n = pos.shape[2]
-    box = rp[R_HITBOX]
-    diamond = rp[R_DIAMOND]
+    box = rules[R_HITBOX]
+    diamond = rules[R_DIAMOND]
     doomed = np.zeros(n, dtype=np.bool_)
     for a in range(n):
         if not active[m, a]:
@@ -253,13 +257,13 @@ def _collisions(m, pos, vel, active, ship_i, torp_life, mi, rp):
                 doomed[a] = True
                 doomed[b] = True
     # the star: ships (and, where they feel it, torpedoes) within its capture radius
-    if rp[R_STAR] > 0.0:
-        r2 = rp[R_CAPTURE] ** 2
+    if rules[R_STAR] > 0.0:
+        r2 = rules[R_CAPTURE] ** 2
         for b in range(n):
-            if not active[m, b] or (b >= 2 and rp[R_TORP_STAR] == 0.0):
+            if not active[m, b] or (b >= 2 and rules[R_TORP_STAR] == 0.0):
                 continue
             if pos[m, 0, b] ** 2 + pos[m, 1, b] ** 2 < r2:
-                if b < 2 and rp[R_STAR_KILLS] == 0.0:
+                if b < 2 and rules[R_STAR_KILLS] == 0.0:
                     pos[m, 0, b] = -0.5  # moved to the corner, at rest
                     pos[m, 1, b] = -0.5
                     vel[m, 0, b] = 0.0
@@ -269,108 +273,111 @@ def _collisions(m, pos, vel, active, ship_i, torp_life, mi, rp):
     for b in range(n):
         if doomed[b]:
             if b < 2:
-                _kill_ship(m, b, active, ship_i, mi[m, FRAME])
+                _kill_ship(m, b, active, ship_counters, match_state[m, FRAME])
             else:
                 active[m, b] = False
                 torp_life[m, b - 2] = 0
 
 
 @njit(cache=True)
-def _round_logic(m, pos, vel, mass, charge, active, ship_f, ship_i, torp_life, mi, rp):
+def _round_logic(m, pos, vel, mass, charge, active, ship_gauges, ship_counters, torp_life, match_state, rules):
     """End of round (a ship lost, both out of torpedoes, or the time limit), then scoring."""
-    mi[m, ROUND_FRAME] += 1
-    if mi[m, END_TIMER] < 0:
-        lost = ship_i[m, 0, ALIVE] == 0 or ship_i[m, 1, ALIVE] == 0
-        dry = ship_i[m, 0, TORPS] == 0 and ship_i[m, 1, TORPS] == 0
+    match_state[m, ROUND_FRAME] += 1
+    if match_state[m, END_TIMER] < 0:
+        lost = ship_counters[m, 0, ALIVE] == 0 or ship_counters[m, 1, ALIVE] == 0
+        dry = ship_counters[m, 0, TORPS] == 0 and ship_counters[m, 1, TORPS] == 0
         if lost or dry:
-            mi[m, END_TIMER] = int(rp[R_DELAY])
-        elif mi[m, ROUND_FRAME] >= int(rp[R_MAXFRAMES]):
-            mi[m, END_TIMER] = 0
-    if mi[m, END_TIMER] < 0:
+            match_state[m, END_TIMER] = int(rules[R_DELAY])
+        elif match_state[m, ROUND_FRAME] >= int(rules[R_MAXFRAMES]):
+            match_state[m, END_TIMER] = 0
+    if match_state[m, END_TIMER] < 0:
         return
-    if mi[m, END_TIMER] > 0:
-        mi[m, END_TIMER] -= 1
+    if match_state[m, END_TIMER] > 0:
+        match_state[m, END_TIMER] -= 1
         return
     # the round is over: a point to each survivor
-    mi[m, SCORE0] += ship_i[m, 0, ALIVE]
-    mi[m, SCORE1] += ship_i[m, 1, ALIVE]
-    mi[m, ROUNDS_PLAYED] += 1
-    mi[m, ROUND_FRAMES_TOTAL] += mi[m, ROUND_FRAME]
-    played = mi[m, ROUNDS_PLAYED]
-    rounds = int(rp[R_ROUNDS])
-    tied = mi[m, SCORE0] == mi[m, SCORE1]
-    if played >= rounds and (not tied or played >= rounds + int(rp[R_MAXEXTRA])):
-        mi[m, OVER] = 1
+    match_state[m, SCORE0] += ship_counters[m, 0, ALIVE]
+    match_state[m, SCORE1] += ship_counters[m, 1, ALIVE]
+    match_state[m, ROUNDS_PLAYED] += 1
+    match_state[m, ROUND_FRAMES_TOTAL] += match_state[m, ROUND_FRAME]
+    played = match_state[m, ROUNDS_PLAYED]
+    rounds = int(rules[R_ROUNDS])
+    tied = match_state[m, SCORE0] == match_state[m, SCORE1]
+    if played >= rounds and (not tied or played >= rounds + int(rules[R_MAXEXTRA])):
+        match_state[m, OVER] = 1
         return
-    reset_round(m, pos, vel, mass, charge, active, ship_f, ship_i, torp_life, mi, rp)
+    reset_round(m, pos, vel, mass, charge, active, ship_gauges, ship_counters, torp_life, match_state, rules)
 
 
 @njit(cache=True)
-def step_match(m, actions, pos, vel, mass, charge, radius, active, test, ship_f, ship_i,
-               torp_life, mi, rng, fp, kinds, foff, ip, ioff, rp, drifts, kicks, work, iwork):
-    """Advance match ``m`` by one frame with ``actions[m, 0]`` and ``actions[m, 1]``."""
-    if mi[m, OVER] == 1:
+def step_match(m, actions, state, model, work, ship_gauges, ship_counters, torp_life,
+               match_state, rng, rules, drifts, kicks):
+    """Advance match ``m`` by one frame with ``actions[m, 0]`` and ``actions[m, 1]``.
+
+    ``state`` and ``model`` are the match batch's ``engine.Batch.kernel_arguments()``."""
+    if match_state[m, OVER] == 1:
         return
-    mi[m, FRAME] += 1
+    pos = state.pos
+    vel = state.vel
+    mass = state.mass
+    charge = state.charge
+    active = state.active
+    force_params = model.fp
+    match_state[m, FRAME] += 1
     for s in range(2):
-        _control(m, s, actions[m, s], mi[m, FRAME], pos, vel, mass, charge, active, ship_f,
-                 ship_i, torp_life, fp, rng, rp)
-    # motion: the engine's symplectic Euler kernel, dt = 1 frame, with the engine's forces
-    n = pos.shape[2]
-    _, _, _, bad = splitting.advance(0.0, 1.0, 1, pos[m], vel[m], mass[m], charge[m], radius[m],
-                                     active[m], test[m], n, kinds, fp[m], foff, ip, ioff, work,
-                                     iwork, False, np.nan, drifts, kicks)
-    if bad >= 0:
-        mi[m, ERROR] = 1
-        mi[m, OVER] = 1
+        _control(m, s, actions[m, s], match_state[m, FRAME], pos, vel, mass, charge, active,
+                 ship_gauges, ship_counters, torp_life, force_params, rng, rules)
+    # motion: the engine's symplectic Euler kernel on this match's system, dt = 1 frame, with
+    # the engine's forces; its drift wraps positions onto the torus (the batch's box = 1)
+    _, _, _, status = advance_system(m, 0.0, 1.0, 1, state, model, work, False, drifts, kicks)
+    if status >= 0:
+        match_state[m, ERROR] = 1
+        match_state[m, OVER] = 1
         return
-    for b in range(n):
-        if active[m, b]:
-            pos[m, 0, b] = wrap(pos[m, 0, b])
-            pos[m, 1, b] = wrap(pos[m, 1, b])
-    ntorp = int(rp[R_NTORP])
+    ntorp = int(rules[R_NTORP])
     for k in range(2 * ntorp):
         if torp_life[m, k] > 0:
             torp_life[m, k] -= 1
             if torp_life[m, k] == 0:
                 active[m, 2 + k] = False  # bursts harmlessly
-    _collisions(m, pos, vel, active, ship_i, torp_life, mi, rp)
-    _round_logic(m, pos, vel, mass, charge, active, ship_f, ship_i, torp_life, mi, rp)
+    _collisions(m, pos, vel, active, ship_counters, torp_life, match_state, rules)
+    _round_logic(m, pos, vel, mass, charge, active, ship_gauges, ship_counters, torp_life,
+                 match_state, rules)
 
 
 @njit(cache=True)
-def step_all(actions, pos, vel, mass, charge, radius, active, test, ship_f, ship_i, torp_life,
-             mi, rng, fp, kinds, foff, ip, ioff, rp, drifts, kicks):
+def step_all(actions, state, model, ship_gauges, ship_counters, torp_life, match_state, rng,
+             rules, drifts, kicks):
     """Advance every match by one frame (matches already over are left as they are)."""
-    # a match has far fewer bodies than the engine's large-N kernels start at: no workspace
-    work = np.empty(0)
-    iwork = np.empty(0, dtype=np.int64)
-    for m in range(pos.shape[0]):
-        step_match(m, actions, pos, vel, mass, charge, radius, active, test, ship_f, ship_i,
-                   torp_life, mi, rng, fp, kinds, foff, ip, ioff, rp, drifts, kicks, work, iwork)
+    # the game's pair forces run the engine's scalar pair loop (no large-N workspace), as the
+    # recorded replays were played
+    work = Workspace(np.empty(0), np.empty(0, dtype=np.int64), False)
+    for m in range(state.pos.shape[0]):
+        step_match(m, actions, state, model, work, ship_gauges, ship_counters, torp_life,
+                   match_state, rng, rules, drifts, kicks)
 
 
 @njit(cache=True)
-def reset_all(pos, vel, mass, charge, active, ship_f, ship_i, torp_life, mi, rp):
+def reset_all(pos, vel, mass, charge, active, ship_gauges, ship_counters, torp_life, match_state, rules):
     for m in range(pos.shape[0]):
-        for k in range(mi.shape[1]):
-            mi[m, k] = 0
-        reset_round(m, pos, vel, mass, charge, active, ship_f, ship_i, torp_life, mi, rp)
+        for k in range(match_state.shape[1]):
+            match_state[m, k] = 0
+        reset_round(m, pos, vel, mass, charge, active, ship_gauges, ship_counters, torp_life, match_state, rules)
 
 
 @njit(cache=True)
-def write_observation(m, seat, pos, vel, charge, active, ship_f, ship_i, torp_life, mi, rp, raw):
+def write_observation(m, seat, pos, vel, charge, active, ship_gauges, ship_counters, torp_life, match_state, rules, raw):
     """Match ``m`` seen from ``seat`` as the flat array of ``spacewar.protocol.raw_layout``:
     10 header numbers, the own ship's 15, the enemy's 15, then 8 per torpedo slot (own slots
     first, each with a presence flag; an empty slot is all zeros)."""
-    raw[0] = mi[m, FRAME]
-    raw[1] = mi[m, ROUND_FRAME]
-    raw[2] = mi[m, ROUNDS_PLAYED]
-    raw[3] = mi[m, SCORE0 + seat]
-    raw[4] = mi[m, SCORE0 + 1 - seat]
+    raw[0] = match_state[m, FRAME]
+    raw[1] = match_state[m, ROUND_FRAME]
+    raw[2] = match_state[m, ROUNDS_PLAYED]
+    raw[3] = match_state[m, SCORE0 + seat]
+    raw[4] = match_state[m, SCORE0 + 1 - seat]
     raw[5] = seat
-    raw[6] = rp[R_STAR]
-    raw[7] = rp[R_CAPTURE]
+    raw[6] = rules[R_STAR]
+    raw[7] = rules[R_CAPTURE]
     raw[8] = 0.0
     raw[9] = 0.0
     for row in range(2):
@@ -380,17 +387,17 @@ def write_observation(m, seat, pos, vel, charge, active, ship_f, ship_i, torp_li
         raw[o + 1] = pos[m, 1, s]
         raw[o + 2] = vel[m, 0, s]
         raw[o + 3] = vel[m, 1, s]
-        raw[o + 4] = ship_f[m, s, HEADING]
-        raw[o + 5] = ship_f[m, s, OMEGA]
-        raw[o + 6] = ship_f[m, s, FUEL]
-        raw[o + 7] = ship_i[m, s, TORPS]
-        raw[o + 8] = ship_i[m, s, HYPER_LEFT]
-        raw[o + 9] = ship_i[m, s, ALIVE]
-        raw[o + 10] = ship_i[m, s, IN_HYPER]
-        raw[o + 11] = ship_i[m, s, RELOAD]
-        raw[o + 12] = ship_i[m, s, HYPER_RECHARGE]
+        raw[o + 4] = ship_gauges[m, s, HEADING]
+        raw[o + 5] = ship_gauges[m, s, OMEGA]
+        raw[o + 6] = ship_gauges[m, s, FUEL]
+        raw[o + 7] = ship_counters[m, s, TORPS]
+        raw[o + 8] = ship_counters[m, s, HYPER_LEFT]
+        raw[o + 9] = ship_counters[m, s, ALIVE]
+        raw[o + 10] = ship_counters[m, s, IN_HYPER]
+        raw[o + 11] = ship_counters[m, s, RELOAD]
+        raw[o + 12] = ship_counters[m, s, HYPER_RECHARGE]
         raw[o + 13] = charge[m, s]
-        raw[o + 14] = ship_i[m, s, FLIP_CD]
+        raw[o + 14] = ship_counters[m, s, FLIP_CD]
     t = torp_life.shape[1] // 2
     o = 40
     for row in range(2):

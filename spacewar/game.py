@@ -5,21 +5,22 @@
         game.step(actions)            # (M, 2) action codes or Action objects
     game.scores                       # (M, 2)
 
-The force model of a mode is declared with the engine's own force terms (only the terms the
-mode needs) and packed by the engine; the compiled step then calls the engine's integrator
-kernel on each match's bodies.
+The matches are one ``engine.Batch`` (a system per match, on the periodic space of side 1). The
+force model of a mode is declared on it with the engine's own force terms (only the terms the
+mode needs) and packed by the engine; the compiled frame then calls the engine's per-system
+kernel (``engine.batch.advance_system``) on each match.
 """
 import hashlib
 
 import numpy as np
 
-from engine import Simulation, forces
-from engine._cache import project_cache
+from engine import Batch, forces
+from engine.cache import project_cache
 
 from .protocol import Action, observation_from_raw, raw_length
 from .rules import Rules
 
-with project_cache():
+with project_cache("spacewar"):
     from . import core
 
 
@@ -33,9 +34,9 @@ def force_terms(rules):
         targets = None if rules.torpedoes_feel_star else ship_indices
         terms.append(forces.PointMass(mu=mu, pos=(0.0, 0.0), softening=softening, particles=targets))
     if rules.mode == "newtonian":
-        terms.append(forces.NBodyGravity(G=rules.ship_gravity, softening=rules.hit_box, box=1.0))
+        terms.append(forces.NBodyGravity(G=rules.ship_gravity, softening=rules.hit_box))
     if rules.mode == "electric":
-        terms.append(forces.Coulomb(k=rules.coulomb_k, softening=rules.hit_box, box=1.0))
+        terms.append(forces.Coulomb(k=rules.coulomb_k, softening=rules.hit_box))
     terms.append(forces.Thrust())
     return terms
 
@@ -105,37 +106,37 @@ class Game:
         m = len(seeds)
         t = rules.torpedoes
         self.n_bodies = nb = 2 + 2 * t
-        # the engine packs the mode's force terms; a template simulation checks them
-        template = Simulation(dim=2, integrator="symplectic_euler", dt=1.0, capacity=nb)
-        template.add_many(mass=np.full(nb, rules.ship_mass), pos=np.zeros((nb, 2)))
+        # one engine system per match, on the torus of side 1; the mode's force terms are
+        # declared on it and packed by the engine
+        self.batch = batch = Batch(systems=m, dim=2, integrator="symplectic_euler", dt=1.0,
+                                   capacity=nb, box=1.0)
+        batch.add_many(mass=rules.torpedo_mass, pos=np.zeros((nb, 2)),
+                       test=np.arange(nb) >= 2)  # torpedoes feel gravity but exert none
         self.terms = force_terms(rules)
         for term in self.terms:
-            template.add_force(term)
+            batch.add_force(term)
         thrust = self.terms[-1]
-        thrust.set(0, (0.0, 0.0))
-        thrust.set(1, (0.0, 0.0))
-        kinds, fp, foff, ip, ioff = template._current_model()
-        self._static_model = (kinds, foff, ip, ioff)
-        self.fp = np.repeat(fp[None, :], m, axis=0)
-        self.rp = _rules_vector(rules, self.rounds, int(foff[len(self.terms) - 1]))
+        thrust_columns = batch.parameter_columns(thrust, "force")  # written by the rules each frame
+        self.state, self.model = batch.kernel_arguments()
+        self.rules_vector = _rules_vector(rules, self.rounds, thrust_columns[0])
         self.drifts, self.kicks = core.drift_kick()
-        # state
-        self.pos = np.zeros((m, 2, nb))
-        self.vel = np.zeros((m, 2, nb))
-        self.mass = np.full((m, nb), rules.torpedo_mass)
-        self.charge = np.zeros((m, nb))
-        self.radius = np.zeros((m, nb))
-        self.active = np.zeros((m, nb), dtype=np.bool_)
-        self.test = np.zeros((m, nb), dtype=np.bool_)
-        self.test[:, 2:] = True  # torpedoes feel gravity but exert none
-        self.ship_f = np.zeros((m, 2, core.SF))
-        self.ship_i = np.zeros((m, 2, core.SI), dtype=np.int64)
+        # the game's own state, beside the engine's
+        self.ship_gauges = np.zeros((m, 2, core.SF))
+        self.ship_counters = np.zeros((m, 2, core.SI), dtype=np.int64)
         self.torp_life = np.zeros((m, 2 * t), dtype=np.int64)
-        self.mi = np.zeros((m, core.MI), dtype=np.int64)
+        self.match_state = np.zeros((m, core.MI), dtype=np.int64)
         self.rng = np.array([seed_state(s) for s in seeds], dtype=np.uint64)
         self._actions = np.full((m, 2), core.NOOP, dtype=np.int64)
-        core.reset_all(self.pos, self.vel, self.mass, self.charge, self.active, self.ship_f,
-                       self.ship_i, self.torp_life, self.mi, self.rp)
+        core.reset_all(self.pos, self.vel, self.mass, self.charge, self.active, self.ship_gauges,
+                       self.ship_counters, self.torp_life, self.match_state, self.rules_vector)
+
+    # the engine's arrays of every match: (M, 2, bodies) positions and velocities, (M, bodies)
+    # masses, charges and active flags (the batch's storage, which the compiled frame writes)
+    pos = property(lambda self: self.state.pos)
+    vel = property(lambda self: self.state.vel)
+    mass = property(lambda self: self.state.mass)
+    charge = property(lambda self: self.state.charge)
+    active = property(lambda self: self.state.active)
 
     # -- stepping -------------------------------------------------------------------
     @property
@@ -148,10 +149,9 @@ class Game:
             self._actions[:] = core.NOOP
         else:
             self._actions[:] = self._encode(actions)
-        kinds, foff, ip, ioff = self._static_model
-        core.step_all(self._actions, self.pos, self.vel, self.mass, self.charge, self.radius,
-                      self.active, self.test, self.ship_f, self.ship_i, self.torp_life, self.mi,
-                      self.rng, self.fp, kinds, foff, ip, ioff, self.rp, self.drifts, self.kicks)
+        core.step_all(self._actions, self.state, self.model, self.ship_gauges, self.ship_counters,
+                      self.torp_life, self.match_state, self.rng, self.rules_vector, self.drifts,
+                      self.kicks)
 
     def _encode(self, actions):
         if isinstance(actions, np.ndarray) and actions.dtype.kind in "iu":
@@ -168,21 +168,21 @@ class Game:
     # -- read-out -------------------------------------------------------------------
     @property
     def over(self):
-        return self.mi[:, core.OVER].astype(bool)
+        return self.match_state[:, core.OVER].astype(bool)
 
     @property
     def scores(self):
-        return self.mi[:, [core.SCORE0, core.SCORE1]].copy()
+        return self.match_state[:, [core.SCORE0, core.SCORE1]].copy()
 
     @property
     def frame(self):
-        return self.mi[:, core.FRAME].copy()
+        return self.match_state[:, core.FRAME].copy()
 
     def rounds_played(self, m=0):
-        return int(self.mi[m, core.ROUNDS_PLAYED])
+        return int(self.match_state[m, core.ROUNDS_PLAYED])
 
     def errored(self, m=0):
-        return bool(self.mi[m, core.ERROR])
+        return bool(self.match_state[m, core.ERROR])
 
     def raw_observation(self, m, seat, out=None):
         """The observation of match ``m`` from seat ``seat`` as a flat float64 array
@@ -200,7 +200,7 @@ class Game:
         else:
             raw = out
         core.write_observation(int(m), int(seat), self.pos, self.vel, self.charge, self.active,
-                               self.ship_f, self.ship_i, self.torp_life, self.mi, self.rp, raw)
+                               self.ship_gauges, self.ship_counters, self.torp_life, self.match_state, self.rules_vector, raw)
         return raw
 
     def observe(self, m, seat):
@@ -213,26 +213,44 @@ class Game:
         t = self.rules.torpedoes
         ships = []
         for s in range(2):
-            i = self.ship_i[m, s]
-            ships.append({"pos": self.pos[m, :, s].tolist(), "heading": float(self.ship_f[m, s, core.HEADING]),
+            i = self.ship_counters[m, s]
+            ships.append({"pos": self.pos[m, :, s].tolist(), "heading": float(self.ship_gauges[m, s, core.HEADING]),
                           "alive": bool(i[core.ALIVE]), "in_hyperspace": bool(i[core.IN_HYPER]),
                           "thrusting": bool(i[core.THRUSTING]), "killed_at": int(i[core.KILLED_AT]),
-                          "fuel": float(self.ship_f[m, s, core.FUEL]), "torpedoes": int(i[core.TORPS]),
+                          "fuel": float(self.ship_gauges[m, s, core.FUEL]), "torpedoes": int(i[core.TORPS]),
                           "charge": float(self.charge[m, s])})
         live = [b for b in range(2, 2 + 2 * t) if self.active[m, b]]
-        return {"frame": int(self.mi[m, core.FRAME]), "round_frame": int(self.mi[m, core.ROUND_FRAME]),
-                "round": int(self.mi[m, core.ROUNDS_PLAYED]), "scores": self.scores[m].tolist(),
+        return {"frame": int(self.match_state[m, core.FRAME]), "round_frame": int(self.match_state[m, core.ROUND_FRAME]),
+                "round": int(self.match_state[m, core.ROUNDS_PLAYED]), "scores": self.scores[m].tolist(),
                 "ships": ships,
                 "torpedoes": [{"pos": self.pos[m, :, b].tolist(), "owner": (b - 2) // t} for b in live],
-                "star": self.rules.effective_star_mu > 0, "over": bool(self.mi[m, core.OVER])}
+                "star": self.rules.effective_star_mu > 0, "over": bool(self.match_state[m, core.OVER])}
 
     def state_hash(self, m=0):
         """SHA-256 of every array of match ``m``: equal hashes mean bit-identical states."""
         h = hashlib.sha256()
-        for arr in (self.pos, self.vel, self.mass, self.charge, self.active, self.ship_f,
-                    self.ship_i, self.torp_life, self.mi, self.rng, self.fp):
+        for arr in (self.pos, self.vel, self.mass, self.charge, self.active, self.ship_gauges,
+                    self.ship_counters, self.torp_life, self.match_state, self.rng):
             h.update(np.ascontiguousarray(arr[m]).tobytes())
+        h.update(self._hashed_parameters(m).tobytes())
         return h.hexdigest()
+
+    def _hashed_parameters(self, m):
+        """Match m's force parameters as the state hash has always covered them, so replays
+        recorded before the game ran on ``engine.Batch`` still verify: each term's packed
+        floats, with the torus side in the pair terms' box entry (the batch's space now holds
+        it) and only the two ships' thrust (the torpedo slots' is always zero)."""
+        row = self.model.fp[m]
+        foff = self.model.foff
+        parts = []
+        for k, term in enumerate(self.terms):
+            block = row[foff[k]:foff[k + 1]].copy()
+            if isinstance(term, (forces.NBodyGravity, forces.Coulomb)):
+                block[term.layout(self.batch)["box"][0]] = self.batch.box
+            if isinstance(term, forces.Thrust):
+                block = block[:4]
+            parts.append(block)
+        return np.concatenate(parts)
 
 
 __all__ = ["Game", "force_terms", "seed_state"]

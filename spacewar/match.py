@@ -93,7 +93,7 @@ def play_match(p1, p2, seed=0, rounds=5, rules=None, budget=DEFAULT_BUDGET,
         actions = np.full((1, 2), core.NOOP, dtype=np.int64)
         raws = [np.empty(raw_length(rules)) for _ in seats]  # every seat copies what it keeps
         while not game.over[0] and not any(forfeits):
-            frame = int(game.mi[0, core.FRAME])
+            frame = int(game.match_state[0, core.FRAME])
             kinds = [0, 0]
             for s, seat in enumerate(seats):
                 code, fault = seat.act(game.raw_observation(0, s, out=raws[s]))

@@ -314,17 +314,17 @@ def _run(pygame, screen, game, seat, p2, seed, rounds, fps, scale, source, max_s
                 if len(fault_examples) < 3:
                     fault_examples.append({"frame": int(game.frame[0]), "kind": fault[0],
                                            "message": fault[1]})
-            before_torps = game.ship_i[0, :, core.TORPS].copy()
-            before_hyper = game.ship_i[0, :, core.IN_HYPER].copy()
+            before_torps = game.ship_counters[0, :, core.TORPS].copy()
+            before_hyper = game.ship_counters[0, :, core.IN_HYPER].copy()
             before_round = game.rounds_played(0)
             prev_pos = game.pos[0].copy()
             prev_active = game.active[0].copy()
             game.step(actions)
             if game.rounds_played(0) == before_round:
-                after_torps = game.ship_i[0, :, core.TORPS]
+                after_torps = game.ship_counters[0, :, core.TORPS]
                 for s in range(2):
                     fired[s] += int(max(0, before_torps[s] - after_torps[s]))
-                    if game.ship_i[0, s, core.IN_HYPER] and not before_hyper[s]:
+                    if game.ship_counters[0, s, core.IN_HYPER] and not before_hyper[s]:
                         jumps[s] += 1
                     if prev_active[s] and game.active[0, s]:
                         step = _wrap(game.pos[0, :, s] - prev_pos[:, s])
@@ -354,8 +354,8 @@ def _draw(pygame, screen, fonts, game, effects, p2, rounds, clock, prev_pos, pre
     snapshot = game.snapshot(0)
     if not paused and not snapshot["over"]:
         snapshot = _blend(snapshot, game, prev_pos, prev_active, clock.alpha)
-    me = game.ship_i[0, 0]
-    fuel = 100.0 * game.ship_f[0, 0, core.FUEL] / max(game.rules.fuel, 1e-300)
+    me = game.ship_counters[0, 0]
+    fuel = 100.0 * game.ship_gauges[0, 0, core.FUEL] / max(game.rules.fuel, 1e-300)
     status = (f"fuel {fuel:3.0f}%   torpedoes {int(me[core.TORPS])}   "
               f"hyperspace {int(me[core.HYPER_LEFT])}")
     footer = [(status, SHIP_COLOURS[0])] + [(line, DIM_TEXT) for line in help_lines]

@@ -579,7 +579,7 @@ def _replay_match(replay):
         for i in range(rows.shape[0]):
             if game.over[0]:
                 break
-            frame = int(game.mi[0, core.FRAME])
+            frame = int(game.match_state[0, core.FRAME])
             asked += 1
             for s in range(2):
                 code = int(rows[i, s])

@@ -165,6 +165,9 @@ def printable(text):
     return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
 
 
+_PROJECT_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
 def _bot_environment(scratch):
     env = {"PATH": "/usr/bin:/bin", "HOME": scratch, "TMPDIR": scratch, "LANG": "C.UTF-8",
            "PYTHONHASHSEED": "0", "PYTHONNOUSERSITE": "1", "PYTHONDONTWRITEBYTECODE": "1",
@@ -175,6 +178,9 @@ def _bot_environment(scratch):
             env[key] = os.environ[key]
     if "SPACEWAR_BOT_TAG" in os.environ:  # lets a caller find its bots' processes (tests do)
         env["SPACEWAR_BOT"] = os.environ["SPACEWAR_BOT_TAG"]
+    # the bot's host imports the very project this match runs (a checkout run in place beside
+    # another installed copy would otherwise start the installed one, which it may not read)
+    env["PYTHONPATH"] = _PROJECT_ROOT
     return env
 
 
@@ -223,7 +229,7 @@ class ProcessSeat:
         config = {
             "spec": absolute_spec(spec), "seed": int(seed), "rules": rules.to_dict(),
             "path": search_path, "output_bytes": limits.output_bytes,
-            "confinement": {"numba_cache": _compiled_code_dir(), "scratch": scratch,
+            "confinement": {"numba_cache": _compiled_code_dirs(), "scratch": scratch,
                             "scratch_mb": limits.scratch_mb, "memory_mb": limits.memory_mb,
                             "file_mb": limits.file_mb, "max_files": limits.max_files,
                             "namespaces": self._namespaces, "user": self._user,
@@ -528,11 +534,12 @@ class ProcessSeat:
 
 
 @functools.lru_cache(maxsize=None)
-def _compiled_code_dir():
-    """The project's compiled-code directory (named by a hash of its sources: found once)."""
-    from engine._cache import cache_dir
+def _compiled_code_dirs():
+    """The engine's and the game's compiled-code directories (named by hashes of their
+    sources: found once)."""
+    from engine.cache import cache_dir
 
-    return cache_dir()
+    return [cache_dir("engine"), cache_dir("spacewar")]
 
 
 _DIR_PREFIX = "spacewar-bot-"

@@ -1,7 +1,7 @@
 """Small numba helpers the force kernels share."""
-import math
-
 from numba import njit
+
+from ..space import wrap_scalar as nearest_image
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -23,14 +23,6 @@ def delta(pos, i, j, dim):
     dy = pos[1, j] - pos[1, i]
     dz = pos[2, j] - pos[2, i] if dim == 3 else 0.0
     return dx, dy, dz
-
-
-@njit(cache=True, error_model="numpy", inline="always")
-def nearest_image(dx, box):
-    """Minimum-image separation on a periodic box of side ``box`` (no change when box == 0)."""
-    if box > 0.0:
-        return dx - box * math.floor(dx / box + 0.5)
-    return dx
 
 
 @njit(cache=True, error_model="numpy", inline="always")

@@ -1,11 +1,14 @@
 """What every force term shares: packing its parameters for the compiled dispatcher.
 
 A force term is a Python object holding its parameters plus two numba kernels in its module:
-``accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc)``
-adds its acceleration into ``acc`` and ``potential(...)`` (the same arguments but ``acc``)
-returns its potential energy (0.0 when the term is not conservative). The term's float
-parameters are ``fp[f0:f1]`` and its integer ones ``ip[i0:i1]``. The simulation concatenates all declared terms into
-one table so that a step calls one compiled function and pays only for the declared terms.
+``accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work)`` adds its acceleration into
+``acc[:, :state.n]`` (``state`` an ``engine.state.State``, ``work`` an
+``engine.state.Workspace`` of scratch for the large-N pair kernels), and
+``potential(t, state, fp, f0, f1, ip, i0, i1)`` returns its potential energy (0.0 when the
+term is not conservative). The term's float parameters are ``fp[f0:f1]``, laid out as its
+class's ``LAYOUT`` names them, and its integer ones (particle indices) ``ip[i0:i1]``. The
+simulation concatenates all declared terms into one table so that a step calls one compiled
+function and pays only for the declared terms.
 """
 import functools
 
@@ -48,6 +51,10 @@ class Force:
     KIND = -1
     #: True if the term has a potential that ``sim.potential_energy()`` sums.
     conservative = False
+    #: the packed float parameters in order, as ``(name, shape)``; a shape entry is an int,
+    #: ``"dim"`` (the simulation's dimension), ``"slots"`` (its particle slots) or
+    #: ``"items"`` (``len(term)``: one per spring)
+    LAYOUT = ()
     #: parameter name -> check(name, value) returning the value to store
     _settable = {}
 
@@ -74,6 +81,19 @@ class Force:
         return False
 
     # Shared ---------------------------------------------------------------------------
+    def layout(self, sim):
+        """``{name: (offset, shape)}`` of each float parameter within this term's packed
+        block, for ``sim`` (a Simulation or Batch): how callers read and write parameters by
+        name (``Batch.set_parameter``, ``Simulation.parameter``)."""
+        sizes = {"dim": sim.dim, "slots": sim.n}
+        out = {}
+        offset = 0
+        for name, spec in self.LAYOUT:
+            shape = tuple(len(self) if d == "items" else sizes.get(d, d) for d in spec)
+            out[name] = (offset, shape)
+            offset += int(np.prod(shape, dtype=np.int64))
+        return out
+
     def _attach(self, sim):
         self._check(sim)
         if self._sim is not None and self._sim is not sim:

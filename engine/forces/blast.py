@@ -20,8 +20,11 @@ KIND = 9
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc,
-               work, iwork):
+def accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work):
+    pos = state.pos
+    mass = state.mass
+    active = state.active
+    n = state.n
     strength, scale, t0, duration = fp[f0], fp[f0 + 1], fp[f0 + 2], fp[f0 + 3]
     if not (t0 <= t < t0 + duration):
         return
@@ -42,7 +45,7 @@ def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, i
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1):
+def potential(t, state, fp, f0, f1, ip, i0, i1):
     return 0.0
 
 
@@ -58,6 +61,7 @@ class Blast(Force):
     ``duration`` (simulation time; ``duration=inf`` keeps it on)."""
 
     KIND = KIND
+    LAYOUT = (("strength", ()), ("scale", ()), ("start", ()), ("duration", ()), ("center", ("dim",)))
     _settable = {"center": vector, "strength": finite_float, "scale": positive_float,
                  "start": finite_float, "duration": _duration}
 
@@ -76,3 +80,7 @@ class Blast(Force):
     def _pack(self, sim):
         head = np.array([self.strength, self.scale, self.start, self.duration])
         return np.concatenate((head, self.center)), EMPTY_INTS
+
+
+#: the term this module implements (for ``engine.forces.registry``)
+TERM = Blast

@@ -49,8 +49,12 @@ def _submerged_integral(d, radius, dim):
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc,
-               work, iwork):
+def accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work):
+    pos = state.pos
+    mass = state.mass
+    radius = state.radius
+    active = state.active
+    n = state.n
     level, rho_g = fp[f0], fp[f0 + 1]
     up = ip[i0]
     dim = pos.shape[0]
@@ -68,7 +72,11 @@ def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, i
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1):
+def potential(t, state, fp, f0, f1, ip, i0, i1):
+    pos = state.pos
+    radius = state.radius
+    active = state.active
+    n = state.n
     level, rho_g = fp[f0], fp[f0 + 1]
     up = ip[i0]
     dim = pos.shape[0]
@@ -95,6 +103,7 @@ class Buoyancy(Force):
     """Fluid of ``density`` filling everything below ``level`` along axis ``up`` (default y)."""
 
     KIND = KIND
+    LAYOUT = (("level", ()), ("density_times_g", ()))
     conservative = True
     _settable = {"level": finite_float, "density": nonnegative_float, "g": positive_float,
                  "up": _axis}
@@ -112,3 +121,7 @@ class Buoyancy(Force):
 
     def _pack(self, sim):
         return floats(self.level, self.density * self.g), ints(self.up)
+
+
+#: the term this module implements (for ``engine.forces.registry``)
+TERM = Buoyancy

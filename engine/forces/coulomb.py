@@ -20,14 +20,19 @@ KIND = 3
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc,
-               work, iwork):
+def accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work):
+    pos = state.pos
+    mass = state.mass
+    charge = state.charge
+    active = state.active
+    n = state.n
+    space = state.box
     k = fp[f0]
     eps2 = fp[f0 + 1]
-    box = fp[f0 + 2]
+    box = fp[f0 + 2] if fp[f0 + 2] > 0.0 else space  # a deprecated own box, else the space's
     dim = pos.shape[0]
-    if pairwise.usable(n, work, iwork):
-        pairwise.coulomb(pos, mass, charge, active, n, k, eps2, box, acc, work, iwork)
+    if pairwise.usable(n, work):
+        pairwise.coulomb(pos, mass, charge, active, n, k, eps2, box, acc, work)
         return
     for i in range(n):
         if not active[i] or charge[i] == 0.0:
@@ -44,10 +49,15 @@ def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, i
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1):
+def potential(t, state, fp, f0, f1, ip, i0, i1):
+    pos = state.pos
+    charge = state.charge
+    active = state.active
+    n = state.n
+    space = state.box
     k = fp[f0]
     eps2 = fp[f0 + 1]
-    box = fp[f0 + 2]
+    box = fp[f0 + 2] if fp[f0 + 2] > 0.0 else space  # a deprecated own box, else the space's
     dim = pos.shape[0]
     u = 0.0
     for i in range(n):
@@ -68,6 +78,7 @@ class Coulomb(Force):
     """
 
     KIND = KIND
+    LAYOUT = (("k", ()), ("softening_squared", ()), ("box", ()))
     conservative = True
     _settable = {"k": finite_float, "softening": nonnegative_float,
                  "box": optional(positive_float)}
@@ -83,3 +94,7 @@ class Coulomb(Force):
 
     def __repr__(self):
         return f"Coulomb(k={self.k!r}, softening={self.softening!r})"
+
+
+#: the term this module implements (for ``engine.forces.registry``)
+TERM = Coulomb

@@ -1,29 +1,41 @@
 """The compiled force table: one call evaluates every declared term, and only those.
 
-A simulation's terms are packed into ``model = (kinds, fp, foff, ip, ioff)``: term ``s`` has
-kind ``kinds[s]`` and parameters ``fp[foff[s]:foff[s+1]]`` and ``ip[ioff[s]:ioff[s+1]]``. The
-branch per term per evaluation is negligible against the work of the terms themselves, and
-having one signature means every integrator is compiled once and cached, whatever the scene.
+A simulation's terms are packed into an ``engine.state.Model(kinds, fp, foff, ip, ioff)``:
+term ``s`` has kind ``kinds[s]`` and parameters ``fp[foff[s]:foff[s+1]]`` and
+``ip[ioff[s]:ioff[s+1]]``. The branch per term per evaluation is negligible against the work of
+the terms themselves, and having one signature means every integrator is compiled once and
+cached, whatever the scene. Every module of ``engine.forces.registry.TERMS`` has a branch in
+both dispatchers (a test holds it to that).
 
-Kernels take plain arrays and offsets, never tuples or slices, and are compiled without numba's
-reference counting (``_nrt=False``: they never allocate). With it, every array argument of a
-call pays atomic reference-count updates on entry and exit: for a five-body system that was
-seven times the cost of the physics itself (140 ns against 20 ns per evaluation, measured).
+Kernels are compiled without numba's reference counting (``_nrt=False``: they never allocate).
+With it, every array argument of a call pays atomic reference-count updates on entry and exit:
+for a five-body system that was seven times the cost of the physics itself (140 ns against
+20 ns per evaluation, measured). The named tuples of ``engine.state`` are passed as plain
+structs, so reading their fields costs nothing.
 """
 import numpy as np
 from numba import njit
 
+from ..state import Model
 from . import (blast, buoyancy, coulomb, drag, gravity, point_mass, springs, thrust,
                uniform_gravity, wind)
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def accelerations(t, pos, vel, mass, charge, radius, active, test, n, kinds, fp, foff, ip, ioff,
-                  acc, work, iwork):
-    """Overwrite ``acc[:, :n]`` with the total acceleration of every declared term at time t."""
+def accelerations(t, state, model, acc, work):
+    """Overwrite ``acc[:, :n]`` with the total acceleration of every declared term at time t.
+
+    A pinned particle's acceleration is then set to zero: it still exerts its forces (they
+    were summed), but nothing moves it."""
+    n = state.n
     for k in range(acc.shape[0]):
         for i in range(n):
             acc[k, i] = 0.0
+    kinds = model.kinds
+    fp = model.fp
+    foff = model.foff
+    ip = model.ip
+    ioff = model.ioff
     for s in range(kinds.shape[0]):
         f0 = foff[s]
         f1 = foff[s + 1]
@@ -31,41 +43,40 @@ def accelerations(t, pos, vel, mass, charge, radius, active, test, n, kinds, fp,
         i1 = ioff[s + 1]
         kind = kinds[s]
         if kind == gravity.KIND:
-            gravity.accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0,
-                               i1, acc, work, iwork)
+            gravity.accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work)
         elif kind == point_mass.KIND:
-            point_mass.accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0,
-                               i1, acc, work, iwork)
+            point_mass.accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work)
         elif kind == uniform_gravity.KIND:
-            uniform_gravity.accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0,
-                               i1, acc, work, iwork)
+            uniform_gravity.accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work)
         elif kind == coulomb.KIND:
-            coulomb.accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0,
-                               i1, acc, work, iwork)
+            coulomb.accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work)
         elif kind == springs.KIND:
-            springs.accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0,
-                               i1, acc, work, iwork)
+            springs.accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work)
         elif kind == drag.KIND:
-            drag.accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0,
-                               i1, acc, work, iwork)
+            drag.accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work)
         elif kind == thrust.KIND:
-            thrust.accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0,
-                               i1, acc, work, iwork)
+            thrust.accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work)
         elif kind == wind.KIND:
-            wind.accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0,
-                               i1, acc, work, iwork)
+            wind.accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work)
         elif kind == buoyancy.KIND:
-            buoyancy.accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0,
-                               i1, acc, work, iwork)
+            buoyancy.accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work)
         elif kind == blast.KIND:
-            blast.accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0,
-                               i1, acc, work, iwork)
+            blast.accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work)
+    pinned = state.pinned
+    for i in range(n):
+        if pinned[i]:
+            for k in range(acc.shape[0]):
+                acc[k, i] = 0.0
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def potential_terms(t, pos, vel, mass, charge, radius, active, test, n, kinds, fp, foff, ip,
-                    ioff, out):
+def potential_terms(t, state, model, out):
     """Write each term's potential energy into ``out[s]`` (0 for non-conservative terms)."""
+    kinds = model.kinds
+    fp = model.fp
+    foff = model.foff
+    ip = model.ip
+    ioff = model.ioff
     for s in range(kinds.shape[0]):
         f0 = foff[s]
         f1 = foff[s + 1]
@@ -74,22 +85,30 @@ def potential_terms(t, pos, vel, mass, charge, radius, active, test, n, kinds, f
         kind = kinds[s]
         u = 0.0
         if kind == gravity.KIND:
-            u = gravity.potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1)
+            u = gravity.potential(t, state, fp, f0, f1, ip, i0, i1)
         elif kind == point_mass.KIND:
-            u = point_mass.potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1)
+            u = point_mass.potential(t, state, fp, f0, f1, ip, i0, i1)
         elif kind == uniform_gravity.KIND:
-            u = uniform_gravity.potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1)
+            u = uniform_gravity.potential(t, state, fp, f0, f1, ip, i0, i1)
         elif kind == coulomb.KIND:
-            u = coulomb.potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1)
+            u = coulomb.potential(t, state, fp, f0, f1, ip, i0, i1)
         elif kind == springs.KIND:
-            u = springs.potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1)
+            u = springs.potential(t, state, fp, f0, f1, ip, i0, i1)
+        elif kind == drag.KIND:
+            u = drag.potential(t, state, fp, f0, f1, ip, i0, i1)
+        elif kind == thrust.KIND:
+            u = thrust.potential(t, state, fp, f0, f1, ip, i0, i1)
+        elif kind == wind.KIND:
+            u = wind.potential(t, state, fp, f0, f1, ip, i0, i1)
         elif kind == buoyancy.KIND:
-            u = buoyancy.potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1)
+            u = buoyancy.potential(t, state, fp, f0, f1, ip, i0, i1)
+        elif kind == blast.KIND:
+            u = blast.potential(t, state, fp, f0, f1, ip, i0, i1)
         out[s] = u
 
 
 def pack(terms, sim):
-    """Concatenate the terms' parameters into the model tuple the kernels take.
+    """Concatenate the terms' parameters into the ``Model`` the kernels take.
 
     Every term is re-checked against ``sim`` first (indices in range, dimension), so nothing
     changed since it was added can reach the kernels unchecked.
@@ -108,4 +127,4 @@ def pack(terms, sim):
     ioff[1:] = np.cumsum([a.shape[0] for a in ips]) if terms else []
     fp = np.concatenate(fps) if fps else np.zeros(0)
     ip = np.concatenate(ips) if ips else np.zeros(0, dtype=np.int64)
-    return kinds, fp, foff, ip, ioff
+    return Model(kinds, fp, foff, ip, ioff)

@@ -15,8 +15,12 @@ KIND = 5
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc,
-               work, iwork):
+def accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work):
+    pos = state.pos
+    vel = state.vel
+    mass = state.mass
+    active = state.active
+    n = state.n
     c1 = fp[f0]
     c2 = fp[f0 + 1]
     dim = pos.shape[0]
@@ -31,7 +35,7 @@ def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, i
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1):
+def potential(t, state, fp, f0, f1, ip, i0, i1):
     return 0.0
 
 
@@ -39,6 +43,7 @@ class Drag(Force):
     """Drag force ``-linear * v - quadratic * |v| v`` on every active particle."""
 
     KIND = KIND
+    LAYOUT = (("linear", ()), ("quadratic", ()))
     _settable = {"linear": nonnegative_float, "quadratic": nonnegative_float}
 
     def __init__(self, linear=0.0, quadratic=0.0):
@@ -55,3 +60,7 @@ class Drag(Force):
 
     def __repr__(self):
         return f"Drag(linear={self.linear!r}, quadratic={self.quadratic!r})"
+
+
+#: the term this module implements (for ``engine.forces.registry``)
+TERM = Drag

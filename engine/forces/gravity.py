@@ -63,14 +63,19 @@ def _open_space_3d(pos, mass, n, G, eps2, acc):
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc,
-               work, iwork):
+def accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work):
+    pos = state.pos
+    mass = state.mass
+    active = state.active
+    test = state.test
+    n = state.n
+    space = state.box
     G = fp[f0]
     eps2 = fp[f0 + 1]
-    box = fp[f0 + 2]
-    if pairwise.usable(n, work, iwork):
+    box = fp[f0 + 2] if fp[f0 + 2] > 0.0 else space  # a deprecated own box, else the space's
+    if pairwise.usable(n, work):
         single = fp[f0 + 3] != 0.0
-        pairwise.gravity(pos, mass, active, test, n, G, eps2, box, single, acc, work, iwork)
+        pairwise.gravity(pos, mass, active, test, n, G, eps2, box, single, acc, work)
         return
     three = pos.shape[0] == 3
     if box == 0.0 and three and _all_massive_and_active(active, test, n):
@@ -113,10 +118,16 @@ def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, i
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1):
+def potential(t, state, fp, f0, f1, ip, i0, i1):
+    pos = state.pos
+    mass = state.mass
+    active = state.active
+    test = state.test
+    n = state.n
+    space = state.box
     G = fp[f0]
     eps2 = fp[f0 + 1]
-    box = fp[f0 + 2]
+    box = fp[f0 + 2] if fp[f0 + 2] > 0.0 else space  # a deprecated own box, else the space's
     dim = pos.shape[0]
     u = 0.0
     for i in range(n):
@@ -146,6 +157,7 @@ class NBodyGravity(Force):
     """
 
     KIND = KIND
+    LAYOUT = (("G", ()), ("softening_squared", ()), ("box", ()), ("float32", ()))
     conservative = True
 
     PRECISIONS = ("float64", "float32")
@@ -167,3 +179,7 @@ class NBodyGravity(Force):
     def __repr__(self):
         return (f"NBodyGravity(G={self.G!r}, softening={self.softening!r}, box={self.box!r}, "
                 f"precision={self.precision!r})")
+
+
+#: the term this module implements (for ``engine.forces.registry``)
+TERM = NBodyGravity

@@ -26,6 +26,9 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from ..space import image
+from ..state import Workspace
+
 #: reassociation and contraction for vector reductions; never 'nnan'/'ninf' (NaN must survive)
 SIMD_MATH = {"reassoc", "contract", "nsz", "arcp"}
 
@@ -43,28 +46,21 @@ PARALLEL_MIN = 12
 THREADS_MIN = 192
 
 
-def workspace(n):
-    """Scratch arrays for the large-N kernels, made once per ``step(n)`` call (in Python, so
-    compiled code never allocates per force evaluation): compacted coordinates, weights and
-    results (8 n floats) and the index map (n ints). Kernels given a smaller workspace
-    (Spacewar passes none) use the scalar pair loop instead."""
+def workspace(n, threads=True):
+    """Scratch for the large-N kernels, made once per ``step(n)`` call (in Python, so compiled
+    code never allocates per force evaluation): compacted coordinates, weights and results
+    (8 n floats) and the index map (n ints), as an ``engine.state.Workspace``. Kernels given a
+    smaller workspace use the scalar pair loop instead. ``threads=False`` keeps the kernels on
+    the calling thread (a batch, whose systems already spread over the cores)."""
     if n < PARALLEL_MIN:
-        return np.empty(0), np.empty(0, dtype=np.int64)
-    return np.empty(8 * n), np.empty(n, dtype=np.int64)
+        return Workspace(np.empty(0), np.empty(0, dtype=np.int64), bool(threads))
+    return Workspace(np.empty(8 * n), np.empty(n, dtype=np.int64), bool(threads))
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def usable(n, work, iwork):
+def usable(n, work):
     """Does this call take the vectorised path: enough particles, and a workspace for them?"""
-    return n >= PARALLEL_MIN and work.shape[0] >= 8 * n and iwork.shape[0] >= n
-
-
-@njit(cache=True, error_model="numpy", inline="always")
-def _image(d, box, half):
-    """d shifted by whole boxes into [-box/2, box/2] (np.floor keeps d's precision)."""
-    if box > 0.0:
-        return d - box * np.floor(d / box + half)
-    return d
+    return n >= PARALLEL_MIN and work.floats.shape[0] >= 8 * n and work.ints.shape[0] >= n
 
 
 @njit(cache=True, fastmath=SIMD_MATH, error_model="numpy", inline="always")
@@ -84,9 +80,9 @@ def _target(c, x, y, z, alpha, beta, sources, eps2, box, zero, half, ax, ay, az)
     sy = zero
     sz = zero
     for j in range(sources):
-        dx = _image(x[j] - xi, box, half)
-        dy = _image(y[j] - yi, box, half)
-        dz = _image(z[j] - zi, box, half)
+        dx = image(x[j] - xi, box, half)
+        dy = image(y[j] - yi, box, half)
+        dz = image(z[j] - zi, box, half)
         r2 = dx * dx + dy * dy + dz * dz + eps2
         bj = beta[j] / (r2 * math.sqrt(r2))
         bj = zero if j == c else bj
@@ -146,22 +142,22 @@ def _blocks(work, m):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _field(work, m, sources, eps2, box):
+def _field(work, m, sources, eps2, box, threads):
     """The field of the m gathered particles in float64 ``work``."""
     x, y, z, alpha, beta, ax, ay, az = _blocks(work, m)
-    if m >= THREADS_MIN:
+    if threads and m >= THREADS_MIN:
         field(x, y, z, alpha, beta, m, sources, eps2, box, ax, ay, az)
     else:
         field_serial(x, y, z, alpha, beta, m, sources, eps2, box, ax, ay, az)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _field32(work, m, sources, eps2, box):
+def _field32(work, m, sources, eps2, box, threads):
     """The field of the m gathered particles in float32 ``work``."""
     x, y, z, alpha, beta, ax, ay, az = _blocks(work, m)
     e = np.float32(eps2)
     b = np.float32(box)
-    if m >= THREADS_MIN:
+    if threads and m >= THREADS_MIN:
         field32(x, y, z, alpha, beta, m, sources, e, b, ax, ay, az)
     else:
         field32_serial(x, y, z, alpha, beta, m, sources, e, b, ax, ay, az)
@@ -238,9 +234,12 @@ def _gravity_inputs(pos, mass, iwork, m, G, work, cx, cy, cz, length, weight):
 
 
 @njit(cache=True, error_model="numpy")
-def gravity(pos, mass, active, test, n, G, eps2, box, single, acc, work, iwork):
+def gravity(pos, mass, active, test, n, G, eps2, box, single, acc, workspace):
     """acc += gravity of the active non-test particles on every active particle (large N);
     ``single``: pair sums in float32 (the workspace's memory seen as float32)."""
+    work = workspace.floats
+    iwork = workspace.ints
+    threads = workspace.threads
     src = 0
     for i in range(n):
         if active[i] and not test[i]:
@@ -268,17 +267,20 @@ def gravity(pos, mass, active, test, n, G, eps2, box, single, acc, work, iwork):
         weight = _power_of_two_above(gm_max)
         w32 = work.view(np.float32)
         _gravity_inputs(pos, mass, iwork, m, G, w32, cx, cy, cz, length, weight)
-        _field32(w32, m, src, eps2 / (length * length), box / length)
+        _field32(w32, m, src, eps2 / (length * length), box / length, threads)
         _scatter(acc, iwork, m, w32, weight / (length * length))
     else:
         _gravity_inputs(pos, mass, iwork, m, G, work, 0.0, 0.0, 0.0, 1.0, 1.0)
-        _field(work, m, src, eps2, box)
+        _field(work, m, src, eps2, box, threads)
         _scatter(acc, iwork, m, work, 1.0)
 
 
 @njit(cache=True, error_model="numpy")
-def coulomb(pos, mass, charge, active, n, k_e, eps2, box, acc, work, iwork):
+def coulomb(pos, mass, charge, active, n, k_e, eps2, box, acc, workspace):
     """acc += Coulomb accelerations among the active charged particles (large N)."""
+    work = workspace.floats
+    iwork = workspace.ints
+    threads = workspace.threads
     m = 0
     for i in range(n):
         if active[i] and charge[i] != 0.0:
@@ -289,5 +291,5 @@ def coulomb(pos, mass, charge, active, n, k_e, eps2, box, acc, work, iwork):
         i = iwork[c]
         work[3 * m + c] = -k_e * charge[i] / mass[i]
         work[4 * m + c] = charge[i]
-    _field(work, m, m, eps2, box)
+    _field(work, m, m, eps2, box, threads)
     _scatter(acc, iwork, m, work, 1.0)

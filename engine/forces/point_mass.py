@@ -25,8 +25,10 @@ def _target(ip, i0, i1, k):
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc,
-               work, iwork):
+def accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work):
+    pos = state.pos
+    active = state.active
+    n = state.n
     mu = fp[f0]
     eps2 = fp[f0 + 1]
     dim = pos.shape[0]
@@ -49,7 +51,11 @@ def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, i
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1):
+def potential(t, state, fp, f0, f1, ip, i0, i1):
+    pos = state.pos
+    mass = state.mass
+    active = state.active
+    n = state.n
     mu = fp[f0]
     eps2 = fp[f0 + 1]
     dim = pos.shape[0]
@@ -74,6 +80,7 @@ class PointMass(Force):
     """
 
     KIND = KIND
+    LAYOUT = (("mu", ()), ("softening_squared", ()), ("pos", ("dim",)))
     conservative = True
     _settable = {"softening": nonnegative_float}
 
@@ -123,3 +130,7 @@ class PointMass(Force):
 
     def __repr__(self):
         return f"PointMass(mu={self._mu!r}, pos={tuple(self._pos)!r}, softening={self.softening!r})"
+
+
+#: the term this module implements (for ``engine.forces.registry``)
+TERM = PointMass

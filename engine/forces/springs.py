@@ -24,8 +24,11 @@ KIND = 4
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc,
-               work, iwork):
+def accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work):
+    pos = state.pos
+    vel = state.vel
+    mass = state.mass
+    active = state.active
     dim = pos.shape[0]
     m = (i1 - i0) // 2
     for s in range(m):
@@ -48,7 +51,9 @@ def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, i
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1):
+def potential(t, state, fp, f0, f1, ip, i0, i1):
+    pos = state.pos
+    active = state.active
     dim = pos.shape[0]
     m = (i1 - i0) // 2
     u = 0.0
@@ -72,6 +77,7 @@ class Springs(Force):
     """
 
     KIND = KIND
+    LAYOUT = (("k", ("items",)), ("rest_length", ("items",)), ("damping", ("items",)))
     conservative = True
 
     def __init__(self, pairs, k=10.0, rest_length=1.0, damping=0.0):
@@ -172,3 +178,7 @@ def cloth(sim, corner, edge_u, edge_v, nu, nv, mass, k, damping=0.0, shear=True,
     springs = Springs(pairs, k=k, rest_length=rest, damping=damping)
     sim.add_force(springs)
     return idx, springs
+
+
+#: the term this module implements (for ``engine.forces.registry``)
+TERM = Springs

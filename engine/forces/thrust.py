@@ -14,8 +14,11 @@ KIND = 6
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc,
-               work, iwork):
+def accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work):
+    pos = state.pos
+    mass = state.mass
+    active = state.active
+    n = state.n
     dim = pos.shape[0]
     count = min(n, (f1 - f0) // dim)
     for i in range(count):
@@ -26,7 +29,7 @@ def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, i
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1):
+def potential(t, state, fp, f0, f1, ip, i0, i1):
     return 0.0
 
 
@@ -34,6 +37,7 @@ class Thrust(Force):
     """Per-particle control forces; all zero until ``set``."""
 
     KIND = KIND
+    LAYOUT = (("force", ("slots", "dim")),)
 
     def __init__(self):
         super().__init__()
@@ -75,4 +79,13 @@ class Thrust(Force):
         self._touch()
 
     def _pack(self, sim):
-        return self._f.reshape(-1).copy(), EMPTY_INTS
+        """One force per particle slot (zeros beyond those set): the layout's (slots, dim)."""
+        f = np.zeros((sim.n, sim.dim))
+        rows = min(sim.n, self._f.shape[0])
+        if rows and self._f.shape[1] == sim.dim:
+            f[:rows] = self._f[:rows]
+        return f.reshape(-1), EMPTY_INTS
+
+
+#: the term this module implements (for ``engine.forces.registry``)
+TERM = Thrust

@@ -11,8 +11,10 @@ KIND = 2
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc,
-               work, iwork):
+def accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work):
+    pos = state.pos
+    active = state.active
+    n = state.n
     dim = pos.shape[0]
     for i in range(n):
         if not active[i]:
@@ -22,7 +24,11 @@ def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, i
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1):
+def potential(t, state, fp, f0, f1, ip, i0, i1):
+    pos = state.pos
+    mass = state.mass
+    active = state.active
+    n = state.n
     dim = pos.shape[0]
     u = 0.0
     for i in range(n):
@@ -37,6 +43,7 @@ class UniformGravity(Force):
     """Constant gravitational acceleration ``g`` (a vector of the simulation's dimension)."""
 
     KIND = KIND
+    LAYOUT = (("g", ("dim",)),)
     conservative = True
 
     def __init__(self, g=(0.0, -9.8)):
@@ -63,3 +70,7 @@ class UniformGravity(Force):
 
     def __repr__(self):
         return f"UniformGravity(g={tuple(self._g)!r})"
+
+
+#: the term this module implements (for ``engine.forces.registry``)
+TERM = UniformGravity

@@ -20,8 +20,10 @@ KIND = 7
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1, acc,
-               work, iwork):
+def accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work):
+    pos = state.pos
+    mass = state.mass
+    active = state.active
     wx, wy, wz = fp[f0], fp[f0 + 1], fp[f0 + 2]
     wn = math.sqrt(wx * wx + wy * wy + wz * wz)
     if wn == 0.0:
@@ -48,7 +50,7 @@ def accumulate(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, i
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def potential(t, pos, vel, mass, charge, radius, active, test, n, fp, f0, f1, ip, i0, i1):
+def potential(t, state, fp, f0, f1, ip, i0, i1):
     return 0.0
 
 
@@ -59,6 +61,7 @@ class Wind(Force):
     """
 
     KIND = KIND
+    LAYOUT = (("w", (3,)),)
 
     def __init__(self, w, triangles):
         super().__init__()
@@ -96,3 +99,7 @@ def grid_triangles(indices):
     a, b = idx[:-1, :-1].ravel(), idx[1:, :-1].ravel()
     c, d = idx[1:, 1:].ravel(), idx[:-1, 1:].ravel()
     return np.concatenate((np.column_stack((a, b, c)), np.column_stack((a, c, d))))
+
+
+#: the term this module implements (for ``engine.forces.registry``)
+TERM = Wind

@@ -1,7 +1,8 @@
 """Integrators: one module per family, one call shape for all.
 
-``advance(name, t, h, steps, pos, vel, prm, n, model, vdep, t_end, tol)`` runs ``steps`` steps
-in compiled code and returns ``(t, h_next, done, bad)`` (see ``common``).
+``advance(name, t, h, steps, state, model, vdep, t_end, tol)`` runs ``steps`` steps in compiled
+code and returns ``(t, h_next, done, status)`` (see ``common``; ``state`` and ``model`` are the
+named tuples of ``engine.state``).
 """
 import numpy as np
 
@@ -35,17 +36,18 @@ def check_name(name):
     return name
 
 
-def advance(name, t, h, steps, pos, vel, prm, n, model, vdep, t_end=np.nan, tol=1e-9):
-    """Advance the state by ``steps`` steps of integrator ``name``; see ``common``.
+def advance(name, t, h, steps, state, model, vdep, t_end=np.nan, tol=1e-9, work=None):
+    """Advance ``state`` by ``steps`` steps of integrator ``name``; see ``common``.
 
-    ``prm = (mass, charge, radius, active, test)`` and ``model = (kinds, fp, foff, ip, ioff)``
-    are unpacked here, once per call: the compiled kernels take plain arrays.
+    ``state`` and ``model`` are the ``engine.state`` named tuples (``sim.kernel_arguments()``);
+    ``work`` defaults to a fresh ``pairwise.workspace(state.n)``.
     """
-    args = (t, h, steps, pos, vel, *prm, n, *model, *workspace(n), vdep, t_end)
+    if work is None:
+        work = workspace(state.n)
     if name in _COEFFICIENTS:
-        return splitting.advance(*args, *_COEFFICIENTS[name])
+        return splitting.advance(t, h, steps, state, model, work, vdep, t_end, *_COEFFICIENTS[name])
     if name == "euler":
-        return euler.advance(*args)
+        return euler.advance(t, h, steps, state, model, work, vdep, t_end)
     if name == "rk4":
-        return runge_kutta.advance(*args)
-    return dormand_prince.advance(*args, tol)
+        return runge_kutta.advance(t, h, steps, state, model, work, vdep, t_end)
+    return dormand_prince.advance(t, h, steps, state, model, work, vdep, t_end, tol)

@@ -1,8 +1,9 @@
 """Pieces every integrator shares: drift, kick, save/restore and the finiteness check.
 
-Every integrator module exposes ``advance(t, h, steps, pos, vel, prm, n, model, vdep, t_end)``
-returning ``(t, h_next, done, bad)``: the new time, the step to use next (``h`` for fixed-step
-methods), the number of steps completed, and ``bad`` = -1 on success, the index of the first
+Every integrator module exposes ``advance(t, h, steps, state, model, work, vdep, t_end)``
+(the named tuples of ``engine.state``)
+returning ``(t, h_next, done, status)``: the new time, the step to use next (``h`` for fixed-step
+methods), the number of steps completed, and ``status`` = -1 on success, the index of the first
 non-finite particle when a step blew up (the state is then the last finite one and ``done`` is
 the index of the failing step), or -2 when an adaptive step size collapsed, or -3 when an adaptive step would make the
 time non-finite (the state is then the last accepted one). ``t_end`` is only
@@ -13,6 +14,8 @@ import math
 import numpy as np
 from numba import njit
 
+from ..space import wrap_scalar
+
 OK = -1
 STEP_COLLAPSED = -2
 #: an adaptive step would take the time past the largest float (the state is kept)
@@ -20,11 +23,27 @@ TIME_OVERFLOW = -3
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def drift(pos, vel, mask, n, h):
-    """p <- p + h v, v masked to 0 for inactive particles (so they stay exactly put)."""
+def drift(pos, vel, mask, n, h, box):
+    """p <- p + h v, v masked to 0 for inactive and pinned particles (so they stay exactly
+    put), then wrapped onto the periodic space of side ``box`` (none when box is 0)."""
+    if box > 0.0:
+        for k in range(pos.shape[0]):
+            for i in range(n):
+                pos[k, i] = wrap_scalar(pos[k, i] + (h * mask[i]) * vel[k, i], box)
+        return
     for k in range(pos.shape[0]):
         for i in range(n):
             pos[k, i] += (h * mask[i]) * vel[k, i]
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def wrap_positions(pos, mask, n, box):
+    """Every moving particle's position onto the periodic space (a Runge-Kutta step's end)."""
+    if box > 0.0:
+        for k in range(pos.shape[0]):
+            for i in range(n):
+                if mask[i] != 0.0:
+                    pos[k, i] = wrap_scalar(pos[k, i], box)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -44,10 +63,11 @@ def copy_state(src_pos, src_vel, dst_pos, dst_vel, n):
 
 
 @njit(cache=True, error_model="numpy")
-def active_mask(active, n):
+def active_mask(active, pinned, n):
+    """1.0 for the particles that move (active and not pinned), else 0.0."""
     mask = np.empty(n)
     for i in range(n):
-        mask[i] = 1.0 if active[i] else 0.0
+        mask[i] = 1.0 if active[i] and not pinned[i] else 0.0
     return mask
 
 

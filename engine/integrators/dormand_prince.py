@@ -17,7 +17,9 @@ import numpy as np
 from numba import njit
 
 from ..forces.dispatch import accelerations
-from .common import OK, STEP_COLLAPSED, TIME_OVERFLOW, first_nonfinite, first_nonfinite_array
+from ..state import with_motion
+from .common import (OK, STEP_COLLAPSED, TIME_OVERFLOW, active_mask, first_nonfinite,
+                     first_nonfinite_array, wrap_positions)
 
 NAME = "rk45"
 ORDER = 5
@@ -75,17 +77,21 @@ def _error(pos, vel, new_pos, new_vel, kx, kv, h, tol, active, n):
 
 
 @njit(cache=True, error_model="numpy")
-def advance(t, h, steps, pos, vel, mass, charge, radius, active, test, n, kinds, fp, foff, ip,
-            ioff, work, iwork, vdep, t_end, tol):
+def advance(t, h, steps, state, model, work, vdep, t_end, tol):
+    pos = state.pos
+    vel = state.vel
+    active = state.active
+    n = state.n
     dim = pos.shape[0]
+    mask = active_mask(active, state.pinned, n)
     kx = np.empty((7, dim, n))
     kv = np.empty((7, dim, n))
     sx = np.empty((dim, n))
     sv = np.empty((dim, n))
+    stage = with_motion(state, sx, sv)
     has_end = not math.isnan(t_end)
     kx[0, :, :] = vel[:, :n]
-    accelerations(t, pos, vel, mass, charge, radius, active, test, n, kinds, fp, foff, ip, ioff,
-                          kv[0], work, iwork)
+    accelerations(t, state, model, kv[0], work)
     done = 0
     rejected = False
     while done < steps:
@@ -103,24 +109,24 @@ def advance(t, h, steps, pos, vel, mass, charge, radius, active, test, n, kinds,
         for s in range(1, 7):
             _stage_state(pos, vel, kx, kv, s, h_try, n, sx, sv)
             kx[s, :, :] = sv
-            accelerations(t + _C[s] * h_try, sx, sv, mass, charge, radius, active, test, n, kinds, fp, foff, ip, ioff,
-                          kv[s], work, iwork)
+            accelerations(t + _C[s] * h_try, stage, model, kv[s], work)
         # stage 7 state is the fifth-order solution (sx, sv)
-        bad = first_nonfinite(sx, sv, active, n)
-        if bad < 0:
-            bad = first_nonfinite_array(kv[6], active, n)
-        err = math.inf if bad >= 0 else _error(pos, vel, sx, sv, kx, kv, h_try, tol, active, n)
+        status = first_nonfinite(sx, sv, active, n)
+        if status < 0:
+            status = first_nonfinite_array(kv[6], active, n)
+        err = math.inf if status >= 0 else _error(pos, vel, sx, sv, kx, kv, h_try, tol, active, n)
         if err > 1.0:
             factor = _MIN_FACTOR if math.isinf(err) else max(_MIN_FACTOR, _SAFETY * err ** -0.2)
             h = h_try * factor
             rejected = True
             if abs(h) <= 1e-14 * max(1.0, abs(t)):
-                if bad < 0:
-                    bad = first_nonfinite_array(kv[0], active, n)
-                return t, h, done, bad if bad >= 0 else STEP_COLLAPSED
+                if status < 0:
+                    status = first_nonfinite_array(kv[0], active, n)
+                return t, h, done, status if status >= 0 else STEP_COLLAPSED
             continue
         pos[:, :n] = sx
         vel[:, :n] = sv
+        wrap_positions(pos, mask, n, state.box)
         t = t_end if last else t + h_try
         kx[0, :, :] = kx[6]
         kv[0, :, :] = kv[6]

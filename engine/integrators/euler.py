@@ -8,7 +8,8 @@ import numpy as np
 from numba import njit
 
 from ..forces.dispatch import accelerations
-from .common import OK, all_finite, copy_state, first_nonfinite
+from ..space import wrap_scalar
+from .common import OK, active_mask, all_finite, copy_state, first_nonfinite
 
 NAME = "euler"
 ORDER = 1
@@ -16,8 +17,13 @@ FORCE_EVALUATIONS = 1
 
 
 @njit(cache=True, error_model="numpy")
-def advance(t, h, steps, pos, vel, mass, charge, radius, active, test, n, kinds, fp, foff, ip,
-            ioff, work, iwork, vdep, t_end):
+def advance(t, h, steps, state, model, work, vdep, t_end):
+    pos = state.pos
+    vel = state.vel
+    n = state.n
+    box = state.box
+    mask = active_mask(state.active, state.pinned, n)
+    active = state.active
     dim = pos.shape[0]
     acc = np.empty((dim, n))
     save_pos = np.empty((dim, n))
@@ -25,17 +31,16 @@ def advance(t, h, steps, pos, vel, mass, charge, radius, active, test, n, kinds,
     t0 = t
     for step in range(steps):
         copy_state(pos, vel, save_pos, save_vel, n)
-        accelerations(t, pos, vel, mass, charge, radius, active, test, n, kinds, fp, foff, ip, ioff,
-                          acc, work, iwork)
+        accelerations(t, state, model, acc, work)
         for k in range(dim):
             for i in range(n):
-                if active[i]:
-                    pos[k, i] += h * vel[k, i]
+                if mask[i] != 0.0:
+                    pos[k, i] = wrap_scalar(pos[k, i] + h * vel[k, i], box)
                     vel[k, i] += h * acc[k, i]
         if not all_finite(pos, vel, n):
-            bad = first_nonfinite(pos, vel, active, n)
-            if bad >= 0:
+            status = first_nonfinite(pos, vel, active, n)
+            if status >= 0:
                 copy_state(save_pos, save_vel, pos, vel, n)
-                return t, h, step, bad
+                return t, h, step, status
         t = t0 + (step + 1) * h
     return t, h, steps, OK

@@ -1,6 +1,6 @@
 """The splitting methods fused with open-space gravity, for a few bodies over many steps.
 
-A scene that is exactly one ``NBodyGravity`` term without a periodic box, on fewer active
+A scene that is exactly one ``NBodyGravity`` term in open space (no periodic box), on fewer active
 bodies than the vectorised kernels start at (``pairwise.PARALLEL_MIN``) and with no test
 particles, is the planetary-system case: five bodies, millions of steps. There the general
 executor of ``splitting`` spends more time on its generality (the force-table call with its
@@ -34,14 +34,17 @@ BLOCK = 64
 
 
 @njit(cache=True, error_model="numpy")
-def applies(pos, active, test, n, kinds, fp):
-    """Is this call the fused case: one open-space gravity term, few bodies, no test ones?"""
-    if kinds.shape[0] != 1 or kinds[0] != gravity.KIND or fp[2] != 0.0:
+def applies(state, model):
+    """Is this call the fused case: one open-space gravity term, few bodies, none of them test
+    particles or pinned?"""
+    kinds = model.kinds
+    if kinds.shape[0] != 1 or kinds[0] != gravity.KIND or model.fp[model.foff[0] + 2] != 0.0:
         return False
-    if n >= pairwise.PARALLEL_MIN or pos.shape[0] > 3:
+    n = state.n
+    if state.box != 0.0 or n >= pairwise.PARALLEL_MIN or state.pos.shape[0] > 3:
         return False
     for i in range(n):
-        if active[i] and test[i]:
+        if state.active[i] and (state.test[i] or state.pinned[i]):
             return False
     return True
 
@@ -166,7 +169,7 @@ def advance(t, h, steps, pos, vel, mass, active, n, G, eps2, drifts, kicks):
     saved_A = np.empty((m, 3))
     fresh = False
     done = 0
-    bad = OK
+    status = OK
     careful = False  # after a failed block: re-run it one step at a time
     while done < steps:
         count = 1 if careful else min(BLOCK, steps - done)
@@ -180,11 +183,11 @@ def advance(t, h, steps, pos, vel, mass, active, n, G, eps2, drifts, kicks):
         _copy(saved_P, saved_V, saved_A, P, V, A, m)
         fresh = saved_fresh
         if careful:
-            bad = index[row]
+            status = index[row]
             break
         careful = True
     for c in range(m):
         for k in range(dim):
             pos[k, index[c]] = P[c, k]
             vel[k, index[c]] = V[c, k]
-    return (t if done == 0 else t + done * h), h, done, bad
+    return (t if done == 0 else t + done * h), h, done, status

@@ -9,7 +9,8 @@ import numpy as np
 from numba import njit
 
 from ..forces.dispatch import accelerations
-from .common import OK, all_finite, first_nonfinite
+from ..state import with_motion
+from .common import OK, active_mask, all_finite, first_nonfinite, wrap_positions
 
 NAME = "rk4"
 ORDER = 4
@@ -26,9 +27,12 @@ def _stage(pos, vel, dx, dv, c, n, out_pos, out_vel):
 
 
 @njit(cache=True, error_model="numpy")
-def advance(t, h, steps, pos, vel, mass, charge, radius, active, test, n, kinds, fp, foff, ip,
-            ioff, work, iwork, vdep, t_end):
+def advance(t, h, steps, state, model, work, vdep, t_end):
+    pos = state.pos
+    vel = state.vel
+    n = state.n
     dim = pos.shape[0]
+    mask = active_mask(state.active, state.pinned, n)
     a1 = np.empty((dim, n))
     a2 = np.empty((dim, n))
     a3 = np.empty((dim, n))
@@ -39,32 +43,33 @@ def advance(t, h, steps, pos, vel, mass, charge, radius, active, test, n, kinds,
     v3 = np.empty((dim, n))
     x4 = np.empty((dim, n))
     v4 = np.empty((dim, n))
+    # the stage states, made once: the loop only writes into their arrays
+    s2 = with_motion(state, x2, v2)
+    s3 = with_motion(state, x3, v3)
+    s4 = with_motion(state, x4, v4)
     t0 = t
     for step in range(steps):
-        accelerations(t, pos, vel, mass, charge, radius, active, test, n, kinds, fp, foff, ip, ioff,
-                          a1, work, iwork)
+        accelerations(t, state, model, a1, work)
         _stage(pos, vel, vel, a1, 0.5 * h, n, x2, v2)
-        accelerations(t + 0.5 * h, x2, v2, mass, charge, radius, active, test, n, kinds, fp, foff, ip, ioff,
-                          a2, work, iwork)
+        accelerations(t + 0.5 * h, s2, model, a2, work)
         _stage(pos, vel, v2, a2, 0.5 * h, n, x3, v3)
-        accelerations(t + 0.5 * h, x3, v3, mass, charge, radius, active, test, n, kinds, fp, foff, ip, ioff,
-                          a3, work, iwork)
+        accelerations(t + 0.5 * h, s3, model, a3, work)
         _stage(pos, vel, v3, a3, h, n, x4, v4)
-        accelerations(t + h, x4, v4, mass, charge, radius, active, test, n, kinds, fp, foff, ip, ioff,
-                          a4, work, iwork)
+        accelerations(t + h, s4, model, a4, work)
         # write the update into x2/v2 first so a blow-up leaves pos/vel untouched
         for k in range(dim):
             for i in range(n):
-                if active[i]:
+                if mask[i] != 0.0:
                     x2[k, i] = pos[k, i] + h / 6.0 * (vel[k, i] + 2.0 * v2[k, i] + 2.0 * v3[k, i] + v4[k, i])
                     v2[k, i] = vel[k, i] + h / 6.0 * (a1[k, i] + 2.0 * a2[k, i] + 2.0 * a3[k, i] + a4[k, i])
                 else:
                     x2[k, i] = pos[k, i]
                     v2[k, i] = vel[k, i]
         if not all_finite(x2, v2, n):
-            bad = first_nonfinite(x2, v2, active, n)
-            if bad >= 0:
-                return t, h, step, bad
+            status = first_nonfinite(x2, v2, state.active, n)
+            if status >= 0:
+                return t, h, step, status
+        wrap_positions(x2, mask, n, state.box)
         pos[:, :n] = x2
         vel[:, :n] = v2
         t = t0 + (step + 1) * h

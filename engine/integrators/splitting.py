@@ -65,17 +65,23 @@ def force_evaluations(name):
 
 
 @njit(cache=True, error_model="numpy")
-def advance(t, h, steps, pos, vel, mass, charge, radius, active, test, n, kinds, fp, foff, ip,
-            ioff, work, iwork, vdep, t_end, drifts, kicks):
-    if fused_gravity.applies(pos, active, test, n, kinds, fp):
-        return fused_gravity.advance(t, h, steps, pos, vel, mass, active, n, fp[foff[0]],
-                                     fp[foff[0] + 1], drifts, kicks)
+def advance(t, h, steps, state, model, work, vdep, t_end, drifts, kicks):
+    """``steps`` steps of the scheme (drift ``drifts[k] h``, then kick ``kicks[k] h``)."""
+    if fused_gravity.applies(state, model):
+        f0 = model.foff[0]
+        return fused_gravity.advance(t, h, steps, state.pos, state.vel, state.mass, state.active,
+                                     state.n, model.fp[f0], model.fp[f0 + 1], drifts, kicks)
+    pos = state.pos
+    vel = state.vel
+    active = state.active
+    n = state.n
+    box = state.box
     # Hot-loop rules for numba: every helper is inlined and no array variable is rebound or
     # sliced inside the loop, since each of those costs atomic reference-count updates that
     # would outweigh the physics of a small system many times over.
     dim = pos.shape[0]
     acc = np.empty((dim, n))
-    mask = active_mask(active, n)
+    mask = active_mask(active, state.pinned, n)
     save_pos = np.empty((dim, n))
     save_vel = np.empty((dim, n))
     fresh = False  # does acc hold the forces of the current state?
@@ -85,21 +91,20 @@ def advance(t, h, steps, pos, vel, mass, charge, radius, active, test, n, kinds,
         t_pos = t
         for s in range(drifts.shape[0]):
             if drifts[s] != 0.0:
-                drift(pos, vel, mask, n, drifts[s] * h)
+                drift(pos, vel, mask, n, drifts[s] * h, box)
                 t_pos += drifts[s] * h
                 fresh = False
             if kicks[s] != 0.0:
                 if not fresh:
-                    accelerations(t_pos, pos, vel, mass, charge, radius, active, test, n, kinds,
-                                  fp, foff, ip, ioff, acc, work, iwork)
+                    accelerations(t_pos, state, model, acc, work)
                     fresh = True
                 kick(vel, acc, n, kicks[s] * h)
                 if vdep:
                     fresh = False
         if not all_finite(pos, vel, n):
-            bad = first_nonfinite(pos, vel, active, n)
-            if bad >= 0:
+            status = first_nonfinite(pos, vel, active, n)
+            if status >= 0:
                 copy_state(save_pos, save_vel, pos, vel, n)
-                return t, h, step, bad
+                return t, h, step, status
         t = t0 + (step + 1) * h
     return t, h, steps, OK

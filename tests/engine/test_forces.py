@@ -10,10 +10,10 @@ from engine import Simulation, forces
 def accel(sim):
     """The acceleration the declared terms give now (one tiny Euler step reveals it exactly)."""
     from engine.forces.dispatch import accelerations
-    pos, vel, prm, n, model = sim._kernel_state()
     from engine.forces.pairwise import workspace
-    acc = np.zeros((sim.dim, n))
-    accelerations(sim.t, pos, vel, *prm, n, *model, acc, *workspace(n))
+    state, model = sim.kernel_arguments()
+    acc = np.zeros((sim.dim, state.n))
+    accelerations(sim.t, state, model, acc, workspace(state.n))
     return acc.T
 
 

@@ -25,10 +25,8 @@ def _system(dim, n, seed, softening, integrator, dt, general, inactive=()):
 
 
 def _uses_fused(sim):
-    pos, vel, prm, n, model = sim._kernel_state()
-    mass, charge, radius, active, test = prm
-    kinds, fp = model[0], model[1]
-    return bool(fused_gravity.applies(pos, active, test, n, kinds, fp))
+    state, model = sim.kernel_arguments()
+    return bool(fused_gravity.applies(state, model))
 
 
 @pytest.mark.parametrize("integrator", sorted(splitting.SCHEMES))

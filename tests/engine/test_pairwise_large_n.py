@@ -4,6 +4,7 @@ import pytest
 
 from engine import Simulation, SimulationError, forces
 from engine.forces import pairwise
+from engine.state import EMPTY_WORKSPACE
 
 from .test_forces import accel
 
@@ -70,12 +71,12 @@ def test_without_a_workspace_the_scalar_loop_gives_the_same_field(kind):
                  charge=rng.choice([-1.0, 1.0], n), test=rng.random(n) < 0.2)
     term = forces.NBodyGravity(softening=0.01) if kind == "gravity" else forces.Coulomb(softening=0.01)
     sim.add_force(term)
-    pos, vel, prm, m, model = sim._kernel_state()
+    state, model = sim.kernel_arguments()
+    m = state.n
     vectorised = np.zeros((3, m))
-    accelerations(sim.t, pos, vel, *prm, m, *model, vectorised, *pairwise.workspace(m))
+    accelerations(sim.t, state, model, vectorised, pairwise.workspace(m))
     scalar = np.zeros((3, m))
-    accelerations(sim.t, pos, vel, *prm, m, *model, scalar, np.empty(0),
-                  np.empty(0, dtype=np.int64))
+    accelerations(sim.t, state, model, scalar, EMPTY_WORKSPACE)
     np.testing.assert_allclose(vectorised, scalar, rtol=1e-11, atol=1e-13 * np.abs(scalar).max())
     assert np.abs(scalar).max() > 0.1
 

@@ -36,7 +36,7 @@ class _Payload:
 
     def __reduce__(self):
         return (exec, ("import gc\nfor o in gc.get_objects():\n"
-                       "    if type(o).__name__ == 'Game': o.ship_i[:, 1, 7] = 0",))
+                       "    if type(o).__name__ == 'Game': o.ship_counters[:, 1, 7] = 0",))
 
 
 class _EvilAction(Action):
@@ -64,7 +64,7 @@ class GcKiller:
     def act(self, obs):
         for o in gc.get_objects():
             if type(o).__name__ == "Game":
-                o.ship_i[:, 1 - obs.seat, 7] = 0
+                o.ship_counters[:, 1 - obs.seat, 7] = 0
         return NOOP
 
 

@@ -23,7 +23,7 @@ def set_ship(game, s, pos, vel=(0.0, 0.0), heading=None, m=0):
     game.pos[m, :, s] = pos
     game.vel[m, :, s] = vel
     if heading is not None:
-        game.ship_f[m, s, core.HEADING] = heading
+        game.ship_gauges[m, s, core.HEADING] = heading
 
 
 def add_torpedo(game, owner, pos, vel, ttl, k=0, m=0):
@@ -53,7 +53,7 @@ def run_frames(game, bots, frames, stop_when_over=True):
 
 
 def alive(game, s):
-    return bool(game.ship_i[0, s, core.ALIVE])
+    return bool(game.ship_counters[0, s, core.ALIVE])
 
 
 # -- geometry ---------------------------------------------------------------------------
@@ -172,7 +172,7 @@ def test_sniper_hits_a_coasting_target_in_the_game(star):
         run_frames(game, [sniper, None], 1)
     assert not alive(game, 1)
     assert alive(game, 0)
-    assert rules.torpedoes - game.ship_i[0, 0, core.TORPS] == 1
+    assert rules.torpedoes - game.ship_counters[0, 0, core.TORPS] == 1
 
 
 @pytest.mark.parametrize("target_pos, fires", [((0.2, 0.25), False), ((0.0, 0.1), True)])
@@ -184,12 +184,12 @@ def test_sniper_does_not_waste_torpedoes_on_hopeless_shots(target_pos, fires):
     rules = Rules(star="none")
     game = Game(rules, seeds=[1], rounds=1)
     set_ship(game, 0, (-0.2, -0.2), (0.0, 0.0), heading=0.0)
-    game.ship_f[0, 0, core.FUEL] = 0.0
+    game.ship_gauges[0, 0, core.FUEL] = 0.0
     set_ship(game, 1, target_pos, (2e-4, -1e-4))
     assert (math.hypot(*torus_delta(game.pos[0, :, 0], game.pos[0, :, 1])) < 0.4) == fires
-    game.ship_i[0, 1, core.TORPS] = 0
+    game.ship_counters[0, 1, core.TORPS] = 0
     run_frames(game, [Sniper(), None], 150)
-    used = rules.torpedoes - game.ship_i[0, 0, core.TORPS]
+    used = rules.torpedoes - game.ship_counters[0, 0, core.TORPS]
     assert (used > 0) == fires
 
 
@@ -204,7 +204,7 @@ def test_sniper_holds_fire_at_a_ship_falling_into_the_star():
     path = sniper.enemy_path(obs)
     sol = sniper.solve(obs, path)
     assert sol is not None and sniper.doomed_before(obs, path, sol[0])
-    game.ship_f[0, 0, core.HEADING] = sol[1]
+    game.ship_gauges[0, 0, core.HEADING] = sol[1]
     assert not sniper.fire_ok(game.observe(0, 0), 0, path)
 
 
@@ -229,24 +229,24 @@ def test_bots_answer_valid_actions(name, rules):
     run_frames(game, [bot, other], 250)
     # odd situations: enemy in hyperspace, enemy dead, a torpedo in flight, ship on the star
     obs_states = []
-    game.ship_i[0, 1, core.IN_HYPER] = 1
-    game.ship_i[0, 1, core.HYPER_TIMER] = 30
+    game.ship_counters[0, 1, core.IN_HYPER] = 1
+    game.ship_counters[0, 1, core.HYPER_TIMER] = 30
     game.active[0, 1] = False
     obs_states.append(game.observe(0, 0))
-    game.ship_i[0, 1, core.IN_HYPER] = 0
-    game.ship_i[0, 1, core.ALIVE] = 0
+    game.ship_counters[0, 1, core.IN_HYPER] = 0
+    game.ship_counters[0, 1, core.ALIVE] = 0
     add_torpedo(game, 1, game.pos[0, :, 0] + 0.05, (-2e-3, -2e-3), 40,
                 k=min(3, rules.torpedoes - 1))
     obs_states.append(game.observe(0, 0))
-    game.ship_i[0, 1, core.ALIVE] = 1
+    game.ship_counters[0, 1, core.ALIVE] = 1
     game.active[0, 1] = True
     set_ship(game, 1, (0.0, 0.0), (0.0, 0.0))  # enemy exactly on the star
     obs_states.append(game.observe(0, 0))
     set_ship(game, 0, (0.0, 0.0), (0.0, 0.0))  # me exactly on the star
     obs_states.append(game.observe(0, 0))
-    game.ship_i[0, 0, core.IN_HYPER] = 1
+    game.ship_counters[0, 0, core.IN_HYPER] = 1
     obs_states.append(game.observe(0, 0))
-    game.ship_i[0, 0, core.ALIVE] = 0
+    game.ship_counters[0, 0, core.ALIVE] = 0
     obs_states.append(game.observe(0, 0))
     for obs in obs_states:
         act = bot.act(obs)
@@ -302,7 +302,7 @@ def test_escapes_a_fall_towards_the_star(name):
         game = Game(rules, seeds=[3], rounds=1)
         set_ship(game, 0, (0.16, 0.02), (-7e-4, 0.0), heading=math.pi)
         set_ship(game, 1, (-0.35, 0.0), (0.0, -math.sqrt(mu / 0.35)))
-        game.ship_i[0, 1, core.TORPS] = 0  # the target cannot shoot
+        game.ship_counters[0, 1, core.TORPS] = 0  # the target cannot shoot
         run_frames(game, [bot, None], 1500)
         return alive(game, 0) or game.scores[0, 0] == 1
 
@@ -323,11 +323,11 @@ def test_dodger_sidesteps_a_torpedo(bot_factory, survives):
     game = Game(rules, seeds=[0], rounds=1)
     set_ship(game, 0, (0.0, 0.0), (0.0, 0.0), heading=0.3)
     set_ship(game, 1, (0.4, 0.4), (0.0, 0.0))
-    game.ship_i[0, 1, core.TORPS] = 0
+    game.ship_counters[0, 1, core.TORPS] = 0
     _torpedo_at(game, 0, 0.3, 2.0)
     run_frames(game, [bot_factory(), None], 100)
     assert alive(game, 0) == survives
-    assert game.ship_i[0, 0, core.HYPER_JUMPS] == 0  # dodged by thrust, no jump
+    assert game.ship_counters[0, 0, core.HYPER_JUMPS] == 0  # dodged by thrust, no jump
 
 
 def test_dodger_jumps_as_a_last_resort():
@@ -339,7 +339,7 @@ def test_dodger_jumps_as_a_last_resort():
     dodger = Dodger()
     act = dodger.act(game.observe(0, 0))
     assert act.hyperspace
-    game.ship_i[0, 0, core.HYPER_RECHARGE] = 10  # not available: it tries to sidestep instead
+    game.ship_counters[0, 0, core.HYPER_RECHARGE] = 10  # not available: it tries to sidestep instead
     act = dodger.act(game.observe(0, 0))
     assert not act.hyperspace and act.thrust in (True, False)
 

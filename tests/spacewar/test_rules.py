@@ -47,15 +47,15 @@ def test_motion_is_velocity_then_position_with_the_star_pull():
 def test_thrust_accelerates_along_heading_and_fuel_runs_out():
     rules = Rules(star="none")
     g = Game(rules)
-    h = g.ship_f[0, 0, core.HEADING]
+    h = g.ship_gauges[0, 0, core.HEADING]
     run(g, [THRUST, NOOP], 1)
     np.testing.assert_allclose(g.vel[0, :, 0], rules.thrust * np.array([math.cos(h), math.sin(h)]),
                                rtol=1e-12)
-    fuel = [g.ship_f[0, 0, core.FUEL]]
+    fuel = [g.ship_gauges[0, 0, core.FUEL]]
     frames = 1
-    while g.ship_f[0, 0, core.FUEL] > 0:
+    while g.ship_gauges[0, 0, core.FUEL] > 0:
         run(g, [THRUST, NOOP], 1)
-        fuel.append(g.ship_f[0, 0, core.FUEL])
+        fuel.append(g.ship_gauges[0, 0, core.FUEL])
         frames += 1
     burns = -np.diff(fuel)
     assert burns[:-1].min() >= rules.fuel_burn_min and burns.max() <= rules.fuel_burn_max
@@ -64,14 +64,14 @@ def test_thrust_accelerates_along_heading_and_fuel_runs_out():
     v = g.vel[0, :, 0].copy()
     run(g, [THRUST, NOOP], 10)
     np.testing.assert_array_equal(g.vel[0, :, 0], v)  # no fuel, no thrust
-    assert g.ship_i[0, 0, core.THRUSTING] == 0
+    assert g.ship_counters[0, 0, core.THRUSTING] == 0
 
 
 def test_turn_rate_full_turn_in_100_frames():
     g = Game(Rules(star="none"))
-    h0 = g.ship_f[0, 0, core.HEADING]
+    h0 = g.ship_gauges[0, 0, core.HEADING]
     def heading():
-        h = g.ship_f[0, 0, core.HEADING]
+        h = g.ship_gauges[0, 0, core.HEADING]
         return np.array([math.cos(h), math.sin(h)])
 
     run(g, [Action(turn=1).code(), NOOP], 25)
@@ -86,11 +86,11 @@ def test_angular_momentum_option_accumulates_turn_rate():
     rules = Rules(star="none", angular_momentum=True)
     g = Game(rules)
     run(g, [Action(turn=1).code(), NOOP], 3)
-    assert g.ship_f[0, 0, core.OMEGA] == pytest.approx(3 * rules.angular_accel)
-    w = g.ship_f[0, 0, core.OMEGA]
-    h = g.ship_f[0, 0, core.HEADING]
+    assert g.ship_gauges[0, 0, core.OMEGA] == pytest.approx(3 * rules.angular_accel)
+    w = g.ship_gauges[0, 0, core.OMEGA]
+    h = g.ship_gauges[0, 0, core.HEADING]
     run(g, [NOOP, NOOP], 4)  # keeps spinning with the keys released
-    assert g.ship_f[0, 0, core.HEADING] == pytest.approx(h + 4 * w)
+    assert g.ship_gauges[0, 0, core.HEADING] == pytest.approx(h + 4 * w)
 
 
 def test_torpedo_count_reload_lifetime_and_launch_velocity():
@@ -98,19 +98,19 @@ def test_torpedo_count_reload_lifetime_and_launch_velocity():
     g = Game(rules)
     place(g, 0, (0.0, 0.0), (1e-3, 0.0))
     place(g, 1, (0.3, 0.3))
-    h = g.ship_f[0, 0, core.HEADING]
+    h = g.ship_gauges[0, 0, core.HEADING]
     run(g, [FIRE, NOOP], 1)
     t0 = 2  # ship 0's first torpedo slot
-    assert g.active[0, t0] and g.ship_i[0, 0, core.TORPS] == 31
+    assert g.active[0, t0] and g.ship_counters[0, 0, core.TORPS] == 31
     muzzle = rules.muzzle_speed * np.array([math.cos(h), math.sin(h)])
     np.testing.assert_allclose(g.vel[0, :, t0], np.array([1e-3, 0.0]) + muzzle, rtol=1e-12)
     launches = [1]
     for frame in range(2, 32 * 16 + 200):
-        before = g.ship_i[0, 0, core.TORPS]
+        before = g.ship_counters[0, 0, core.TORPS]
         run(g, [FIRE, NOOP], 1)
-        if g.ship_i[0, 0, core.TORPS] < before:
+        if g.ship_counters[0, 0, core.TORPS] < before:
             launches.append(frame)
-    assert len(launches) == 32 and g.ship_i[0, 0, core.TORPS] == 0
+    assert len(launches) == 32 and g.ship_counters[0, 0, core.TORPS] == 0
     assert set(np.diff(launches)) == {rules.reload}
     # lifetime: the first torpedo burst exactly 96 frames after launch
     g2 = Game(rules)
@@ -126,10 +126,10 @@ def test_torpedo_count_reload_lifetime_and_launch_velocity():
 def test_single_shot_needs_a_release_between_shots():
     g = Game(Rules(star="none", single_shot=True))
     run(g, [FIRE, NOOP], 100)
-    assert g.ship_i[0, 0, core.TORPS] == 31
+    assert g.ship_counters[0, 0, core.TORPS] == 31
     run(g, [NOOP, NOOP], 1)
     run(g, [FIRE, NOOP], 1)
-    assert g.ship_i[0, 0, core.TORPS] == 30
+    assert g.ship_counters[0, 0, core.TORPS] == 30
 
 
 def test_torus_wraparound():
@@ -144,7 +144,7 @@ def test_collision_through_the_edge_uses_the_nearest_image():
     place(g, 0, (0.499, 0.0))
     place(g, 1, (-0.499, 0.0))  # 0.002 apart through the edge
     run(g, [NOOP, NOOP], 1)
-    assert g.ship_i[0, 0, core.ALIVE] == 0 and g.ship_i[0, 1, core.ALIVE] == 0
+    assert g.ship_counters[0, 0, core.ALIVE] == 0 and g.ship_counters[0, 1, core.ALIVE] == 0
 
 
 def test_diamond_hit_test():
@@ -156,21 +156,21 @@ def test_diamond_hit_test():
         place(g, 0, (0.1, 0.1))
         place(g, 1, (0.1 + offset[0], 0.1 + offset[1]))
         run(g, [NOOP, NOOP], 1)
-        assert (g.ship_i[0, 0, core.ALIVE] == 0) == hit, offset
+        assert (g.ship_counters[0, 0, core.ALIVE] == 0) == hit, offset
 
 
 def test_torpedo_hits_ship_and_both_are_destroyed():
     rules = Rules(star="none")
     g = Game(rules)
     place(g, 0, (-0.2, 0.0))
-    g.ship_f[0, 0, core.HEADING] = 0.0
+    g.ship_gauges[0, 0, core.HEADING] = 0.0
     place(g, 1, (0.0, 0.0))
     run(g, [FIRE, NOOP], 1)
     for _ in range(60):
         run(g, [NOOP, NOOP], 1)
-    assert g.ship_i[0, 1, core.ALIVE] == 0 and g.ship_i[0, 0, core.ALIVE] == 1
+    assert g.ship_counters[0, 1, core.ALIVE] == 0 and g.ship_counters[0, 0, core.ALIVE] == 1
     assert not g.active[0, 2]  # the torpedo went with it
-    assert g.ship_i[0, 1, core.KILLED_AT] > 0
+    assert g.ship_counters[0, 1, core.KILLED_AT] > 0
 
 
 def test_torpedo_torpedo_collision():
@@ -178,15 +178,15 @@ def test_torpedo_torpedo_collision():
     g = Game(rules)
     place(g, 0, (-0.2, 0.0))
     place(g, 1, (0.2, 0.0))
-    g.ship_f[0, 0, core.HEADING] = 0.0
-    g.ship_f[0, 1, core.HEADING] = math.pi
+    g.ship_gauges[0, 0, core.HEADING] = 0.0
+    g.ship_gauges[0, 1, core.HEADING] = math.pi
     run(g, [FIRE, FIRE], 1)
     t0, t1 = 2, 2 + rules.torpedoes
     assert g.active[0, t0] and g.active[0, t1]
     for _ in range(45):
         run(g, [NOOP, NOOP], 1)
     assert not g.active[0, t0] and not g.active[0, t1]
-    assert g.ship_i[0, 0, core.ALIVE] == 1 and g.ship_i[0, 1, core.ALIVE] == 1
+    assert g.ship_counters[0, 0, core.ALIVE] == 1 and g.ship_counters[0, 1, core.ALIVE] == 1
 
 
 def test_torpedoes_are_weightless_in_classic_and_feel_the_star_in_newtonian():
@@ -195,7 +195,7 @@ def test_torpedoes_are_weightless_in_classic_and_feel_the_star_in_newtonian():
         g = Game(Rules(mode=mode))
         place(g, 0, (-0.2, 0.05))
         place(g, 1, (0.3, 0.3))
-        g.ship_f[0, 0, core.HEADING] = 0.0
+        g.ship_gauges[0, 0, core.HEADING] = 0.0
         run(g, [FIRE, NOOP], 1)
         v0 = g.vel[0, :, 2].copy()
         run(g, [NOOP, NOOP], 50)
@@ -223,9 +223,9 @@ def test_star_kills_or_teleports():
         place(g, 0, (0.5 * rules.star_capture, 0.0))
         run(g, [NOOP, NOOP], 1)
         if kills:
-            assert g.ship_i[0, 0, core.ALIVE] == 0
+            assert g.ship_counters[0, 0, core.ALIVE] == 0
         else:
-            assert g.ship_i[0, 0, core.ALIVE] == 1
+            assert g.ship_counters[0, 0, core.ALIVE] == 1
             np.testing.assert_allclose(g.pos[0, :, 0], (-0.5, -0.5))
             np.testing.assert_array_equal(g.vel[0, :, 0], 0.0)
 
@@ -233,14 +233,14 @@ def test_star_kills_or_teleports():
 def test_a_ship_at_rest_falls_into_the_heavy_star():
     g = Game(Rules())
     frames = 0
-    while g.ship_i[0, 0, core.ALIVE] and frames < 2000:
+    while g.ship_counters[0, 0, core.ALIVE] and frames < 2000:
         run(g, [NOOP, NOOP], 1)
         frames += 1
-    assert g.ship_i[0, 0, core.ALIVE] == 0 and frames < 1000
+    assert g.ship_counters[0, 0, core.ALIVE] == 0 and frames < 1000
     # the light star pulls a quarter as hard: the fall takes twice as long (t ~ mu^-1/2)
     g = Game(Rules(star="light"))
     light = 0
-    while g.ship_i[0, 0, core.ALIVE] and light < 4000:
+    while g.ship_counters[0, 0, core.ALIVE] and light < 4000:
         run(g, [NOOP, NOOP], 1)
         light += 1
     assert light == pytest.approx(2 * frames, rel=0.05)
@@ -257,25 +257,25 @@ def test_hyperspace_vanish_return_recharge_and_count():
     g = Game(rules)
     start = g.pos[0, :, 0].copy()
     run(g, [HYPER, NOOP], 1)
-    assert g.ship_i[0, 0, core.IN_HYPER] == 1 and not g.active[0, 0]
+    assert g.ship_counters[0, 0, core.IN_HYPER] == 1 and not g.active[0, 0]
     # invisible and untouchable: the enemy flies through the spot it left
     place(g, 1, start)
     run(g, [NOOP, NOOP], 1)
-    assert g.ship_i[0, 1, core.ALIVE] == 1
+    assert g.ship_counters[0, 1, core.ALIVE] == 1
     run(g, [NOOP, NOOP], rules.hyperspace_frames - 2)
-    assert g.ship_i[0, 0, core.IN_HYPER] == 1
+    assert g.ship_counters[0, 0, core.IN_HYPER] == 1
     run(g, [NOOP, NOOP], 1)
-    assert g.ship_i[0, 0, core.IN_HYPER] == 0 and g.active[0, 0]
+    assert g.ship_counters[0, 0, core.IN_HYPER] == 0 and g.active[0, 0]
     assert not np.allclose(g.pos[0, :, 0], start)  # a random place
     # recharge: pressing again does nothing for 128 frames
     run(g, [HYPER, NOOP], rules.hyperspace_recharge - 1)
-    assert g.ship_i[0, 0, core.HYPER_LEFT] == 7
+    assert g.ship_counters[0, 0, core.HYPER_LEFT] == 7
     jumps = 1
     for _ in range(20 * (rules.hyperspace_recharge + rules.hyperspace_frames)):
-        before = g.ship_i[0, 0, core.HYPER_LEFT]
+        before = g.ship_counters[0, 0, core.HYPER_LEFT]
         run(g, [HYPER, NOOP], 1)
-        jumps += int(g.ship_i[0, 0, core.HYPER_LEFT] < before)
-    assert jumps == 8 and g.ship_i[0, 0, core.HYPER_LEFT] == 0
+        jumps += int(g.ship_counters[0, 0, core.HYPER_LEFT] < before)
+    assert jumps == 8 and g.ship_counters[0, 0, core.HYPER_LEFT] == 0
 
 
 def test_hyperspace_break_up_odds_grow_k_over_8():
@@ -290,7 +290,7 @@ def test_hyperspace_break_up_odds_grow_k_over_8():
         g.step(acts)  # jump k
         for _ in range(rules.hyperspace_frames + rules.hyperspace_recharge):
             g.step(np.full((n, 2), NOOP))
-        alive = g.ship_i[:, 0, core.ALIVE] == 1
+        alive = g.ship_counters[:, 0, core.ALIVE] == 1
         rates.append(1 - alive[survivors].mean())
         survivors &= alive
     for k, rate in enumerate(rates, start=1):
@@ -304,17 +304,17 @@ def test_round_scoring_survivor_gets_a_point_after_the_delay():
     g = Game(rules, rounds=3)
     place(g, 1, (0.0, 0.0))
     place(g, 0, (-0.2, 0.0))
-    g.ship_f[0, 0, core.HEADING] = 0.0
+    g.ship_gauges[0, 0, core.HEADING] = 0.0
     run(g, [FIRE, NOOP], 1)
     frames = 1
-    while g.ship_i[0, 1, core.ALIVE]:
+    while g.ship_counters[0, 1, core.ALIVE]:
         run(g, [NOOP, NOOP], 1)
         frames += 1
     assert g.rounds_played() == 0 and g.scores[0].tolist() == [0, 0]
     run(g, [NOOP, NOOP], rules.post_round_delay)
     assert g.rounds_played() == 1 and g.scores[0].tolist() == [1, 0]
     # the next round starts afresh
-    assert g.ship_i[0, 1, core.ALIVE] == 1 and g.ship_i[0, 0, core.TORPS] == rules.torpedoes
+    assert g.ship_counters[0, 1, core.ALIVE] == 1 and g.ship_counters[0, 0, core.TORPS] == rules.torpedoes
 
 
 def test_both_destroyed_scores_nothing_and_dry_round_scores_both():
@@ -324,7 +324,7 @@ def test_both_destroyed_scores_nothing_and_dry_round_scores_both():
     place(g, 1, (0.001, 0.0))
     run(g, [NOOP, NOOP], 1 + rules.post_round_delay)
     assert g.rounds_played() == 1 and g.scores[0].tolist() == [0, 0]
-    g.ship_i[0, :, core.TORPS] = 0  # both out of torpedoes: the round ends, survivors score
+    g.ship_counters[0, :, core.TORPS] = 0  # both out of torpedoes: the round ends, survivors score
     run(g, [NOOP, NOOP], 1 + rules.post_round_delay)
     assert g.rounds_played() == 2 and g.scores[0].tolist() == [1, 1]
 
@@ -342,7 +342,7 @@ def test_electric_polarity_flip_repels_same_charge_torpedoes():
     assert g.charge[0, 0] == -g.charge[0, 1] != 0
     place(g, 0, (0.0, 0.0))
     place(g, 1, (0.3, 0.3))
-    g.ship_f[0, 1, core.HEADING] = math.pi
+    g.ship_gauges[0, 1, core.HEADING] = math.pi
     run(g, [NOOP, FIRE], 1)  # ship 1's torpedo takes ship 1's charge
     t = 2 + rules.torpedoes
     assert g.charge[0, t] == g.charge[0, 1]
@@ -354,7 +354,7 @@ def test_electric_polarity_flip_repels_same_charge_torpedoes():
     v = g.vel[0, 0, t]
     run(g, [NOOP, NOOP], 1)
     assert g.vel[0, 0, t] > v  # same charge now: pushed away
-    cd = g.ship_i[0, 0, core.FLIP_CD]
+    cd = g.ship_counters[0, 0, core.FLIP_CD]
     assert cd > 0
     q = g.charge[0, 0]
     run(g, [FLIP, NOOP], 1)

@@ -1,0 +1,573 @@
+"""Batch: M independent systems that share their force terms and slot count, advanced together.
+
+    batch = Batch(systems=4096, dim=2, integrator="symplectic_euler", dt=1.0, capacity=66)
+    batch.add_many(mass=masses, pos=positions)        # (M, k) and (M, k, dim), or one for all
+    star = batch.add_force(forces.PointMass(mu=1e-3))
+    batch.set_parameter(star, "pos", centres)         # (M, 2): one star position per system
+    batch.step(100)                                   # one compiled call, systems over the cores
+    batch.pos                                         # (M, N, dim) view of the state
+    batch.energy()                                    # (M,)
+
+Every system is advanced by the very kernel a ``Simulation`` runs (``step_system`` below, the
+integrator's ``advance`` on one system's slice of the arrays), so system m of a batch is
+bit-identical to the same system stepped alone in a ``Simulation``, and the result does not
+depend on the number of threads (numba's ``prange`` spreads whole systems over them; nothing is
+summed across systems). REBOUND has no batch of independent systems; Gymnasium's
+``CartPoleVectorEnv`` (state with a leading environment axis, stepped by vectorised code) is
+the model for the layout.
+
+The state has a leading system axis: ``pos``/``vel`` are stored as ``(M, dim, capacity)``
+(component-major per system, as in a ``Simulation``), the per-particle arrays as
+``(M, capacity)``, and the float parameters of the force terms as one row per system
+(``(M, F)``, laid out by the terms' ``LAYOUT`` names). A term's attribute (``drag.linear = 1``)
+sets that parameter for every system; ``set_parameter`` sets it per system, and from then on
+that parameter is per system (a later attribute change leaves it alone).
+
+Compiled code of your own (a game's frame) takes ``batch.kernel_arguments()``: an
+``engine.state.State`` whose arrays carry the system axis, and a ``Model`` whose ``fp`` is
+``(M, F)``; ``system_state(state, m)`` and ``system_model(model, m)`` give one system's
+named tuples, and ``advance_system`` steps it with a splitting scheme.
+"""
+import numbers
+
+import numpy as np
+from numba import njit, prange
+
+from . import diagnostics
+from . import integrators as _integrators
+from ._validate import finite_float, nonnegative_float, positive_float, real_array, step_count
+from .errors import SimulationError
+from .forces.base import Force
+from .forces.dispatch import pack, potential_terms
+from .forces.pairwise import PARALLEL_MIN
+from .integrators import dormand_prince, euler, runge_kutta, splitting
+from .integrators.common import STEP_COLLAPSED, TIME_OVERFLOW
+from .space import check_box
+from .state import Model, State, Workspace
+
+#: integrator families of the compiled batch step
+SPLITTING, EULER, RK4, RK45 = 0, 1, 2, 3
+
+MAX_SYSTEMS = 2 ** 24
+
+
+@njit(cache=True, inline="always")
+def system_state(state, m):
+    """System m of a batch's state (views of its rows), as a one-system ``State``."""
+    return State(state.pos[m], state.vel[m], state.mass[m], state.charge[m], state.radius[m],
+                 state.active[m], state.test[m], state.pinned[m], state.n, state.box)
+
+
+@njit(cache=True, inline="always")
+def system_model(model, m):
+    """System m's force terms: the shared tables with its own row of float parameters."""
+    return Model(model.kinds, model.fp[m], model.foff, model.ip, model.ioff)
+
+
+@njit(cache=True, error_model="numpy")
+def advance_system(m, t, h, steps, state, model, work, vdep, drifts, kicks):
+    """``steps`` steps of a splitting scheme (``splitting.coefficients(name)``) on system m
+    of a batch: the per-system kernel for compiled callers. Returns ``(t, h, done, status)``
+    as every integrator does (``engine.integrators.common``)."""
+    return splitting.advance(t, h, steps, system_state(state, m), system_model(model, m), work,
+                             vdep, np.nan, drifts, kicks)
+
+
+@njit(cache=True, error_model="numpy")
+def step_system(m, family, t, h, steps, state, model, work, vdep, tol, drifts, kicks):
+    """System m advanced by the integrator ``family`` (SPLITTING with its coefficients,
+    EULER, RK4 or RK45 with tolerance ``tol``): exactly what ``Simulation.step`` runs."""
+    s = system_state(state, m)
+    model_m = system_model(model, m)
+    if family == SPLITTING:
+        return splitting.advance(t, h, steps, s, model_m, work, vdep, np.nan, drifts, kicks)
+    if family == EULER:
+        return euler.advance(t, h, steps, s, model_m, work, vdep, np.nan)
+    if family == RK4:
+        return runge_kutta.advance(t, h, steps, s, model_m, work, vdep, np.nan)
+    return dormand_prince.advance(t, h, steps, s, model_m, work, vdep, np.nan, tol)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _workspace(n):
+    """The scratch a ``Simulation`` of n slots would get, kept on this thread."""
+    if n >= PARALLEL_MIN:
+        return Workspace(np.empty(8 * n), np.empty(n, dtype=np.int64), False)
+    return Workspace(np.empty(0), np.empty(0, dtype=np.int64), False)
+
+
+@njit(parallel=True, cache=True, error_model="numpy")
+def advance_all(family, t, h, steps, state, model, vdep, tol, drifts, kicks, done, status):
+    """Every system by ``steps`` steps, whole systems spread over the threads.
+
+    ``t`` and ``h`` (one per system) are updated in place; ``done[m]`` and ``status[m]`` get each
+    system's completed steps and failure code (-1 for success; see ``integrators.common``)."""
+    for m in prange(state.pos.shape[0]):
+        work = _workspace(state.n)
+        tm, hm, dm, bm = step_system(m, family, t[m], h[m], steps, state, model, work, vdep,
+                                     tol, drifts, kicks)
+        t[m] = tm
+        h[m] = hm
+        done[m] = dm
+        status[m] = bm
+
+
+@njit(parallel=True, cache=True, error_model="numpy")
+def energies(t, state, model, moving, terms, kinetic, potential):
+    """Kinetic and potential energy of every system (the diagnostics of a ``Simulation``)."""
+    for m in prange(state.pos.shape[0]):
+        s = system_state(state, m)
+        out = np.zeros(terms)
+        potential_terms(t[m], s, system_model(model, m), out)
+        kinetic[m] = diagnostics.kinetic_energy(s.vel, s.mass, moving[m], s.n)
+        potential[m] = out.sum()
+
+
+class Batch:
+    """M independent systems with the same force terms and particle slots (see the module).
+
+    Parameters mirror ``Simulation``'s: ``systems`` (M >= 1), ``dim``, ``integrator``, ``dt``,
+    ``tolerance`` (rk45), ``G``, ``capacity`` (initial slots per system), ``box`` (side of the
+    periodic space). Quantities are plain floats in code units. ``t`` and ``steps`` are one per
+    system (rk45 adapts each system's step on its own).
+    """
+
+    def __init__(self, systems, dim=2, integrator="symplectic_euler", dt=1.0, tolerance=1e-9,
+                 G=None, capacity=16, box=None):
+        if isinstance(systems, (bool, np.bool_)) or not isinstance(systems, numbers.Integral) \
+                or not 1 <= systems <= MAX_SYSTEMS:
+            raise ValueError(f"systems must be an int in [1, {MAX_SYSTEMS}], got {systems!r}")
+        if isinstance(dim, bool) or dim not in (2, 3):
+            raise ValueError(f"dim must be 2 or 3, got {dim!r}")
+        if isinstance(capacity, (bool, np.bool_)) or not isinstance(capacity, numbers.Integral) \
+                or not 0 <= capacity <= 2 ** 31:
+            raise ValueError(f"capacity must be an int in [0, {2 ** 31}], got {capacity!r}")
+        self._integrator = _integrators.check_name(integrator)
+        dt = finite_float("dt", dt)
+        if dt == 0.0:
+            raise ValueError("dt must be non-zero (negative runs backwards), got 0.0")
+        self._tolerance = positive_float("tolerance", tolerance)
+        self._G = 1.0 if G is None else nonnegative_float("G", G)
+        self._box = check_box(box)
+        self.dim = int(dim)
+        self.systems = int(systems)
+        self.n = 0
+        self._allocate(max(int(capacity), 1))
+        self._t = np.zeros(self.systems)
+        self._h = np.full(self.systems, dt)
+        self._steps = np.zeros(self.systems, dtype=np.int64)
+        self._forces = []
+        self._revision = 0
+        self._model_key = None
+        self._model = None
+        self._layouts = {}
+        self._layout_terms = []
+        self._per_system = []  # (term, name) pairs set per system
+
+    # -- storage ---------------------------------------------------------------------
+    def _allocate(self, capacity):
+        M, dim, old = self.systems, self.dim, self.n
+        fresh = {"_pos": np.zeros((M, dim, capacity)), "_vel": np.zeros((M, dim, capacity)),
+                 "_mass": np.zeros((M, capacity)), "_charge": np.zeros((M, capacity)),
+                 "_radius": np.zeros((M, capacity)),
+                 "_active": np.zeros((M, capacity), dtype=np.bool_),
+                 "_test": np.zeros((M, capacity), dtype=np.bool_),
+                 "_pinned": np.zeros((M, capacity), dtype=np.bool_)}
+        for name, arr in fresh.items():
+            if old:
+                arr[..., :old] = getattr(self, name)[..., :old]
+            setattr(self, name, arr)
+        self.capacity = capacity
+
+    # -- configuration ---------------------------------------------------------------
+    @property
+    def integrator(self):
+        return self._integrator
+
+    @property
+    def dt(self):
+        """The step of system 0 (rk45 adapts each system's own; see ``dts``)."""
+        return float(self._h[0])
+
+    @property
+    def dts(self):
+        return self._h.copy()
+
+    @property
+    def G(self):
+        return self._G
+
+    @property
+    def box(self):
+        return self._box
+
+    @property
+    def t(self):
+        """Time of each system, (M,) (a copy)."""
+        return self._t.copy()
+
+    @property
+    def steps(self):
+        return self._steps.copy()
+
+    def __len__(self):
+        return self.n
+
+    # -- particles -------------------------------------------------------------------
+    @property
+    def pos(self):
+        """Positions, (M, N, dim): a writable view of the state."""
+        return self._pos[:, :, : self.n].transpose(0, 2, 1)
+
+    @property
+    def vel(self):
+        """Velocities, (M, N, dim): a writable view of the state."""
+        return self._vel[:, :, : self.n].transpose(0, 2, 1)
+
+    @property
+    def mass(self):
+        """Masses, (M, N): writable (a mass may differ per system)."""
+        return self._mass[:, : self.n]
+
+    @property
+    def charge(self):
+        return self._charge[:, : self.n]
+
+    @property
+    def radius(self):
+        return self._radius[:, : self.n]
+
+    @property
+    def active(self):
+        """(M, N) active flags (writable: deactivating a particle in one system only)."""
+        return self._active[:, : self.n]
+
+    @property
+    def test(self):
+        view = self._test[:, : self.n]
+        view.flags.writeable = False
+        return view
+
+    @property
+    def pinned(self):
+        view = self._pinned[:, : self.n]
+        view.flags.writeable = False
+        return view
+
+    def add_many(self, mass, pos, vel=None, charge=0.0, radius=0.0, test=False, pinned=False):
+        """Add k particle slots to every system; return their indices, (k,).
+
+        ``pos``/``vel``: (M, k, dim), or (k, dim) for the same in every system; ``mass``,
+        ``charge``, ``radius``: a scalar, (k,) or (M, k); ``test``, ``pinned``: a bool, (k,)
+        or (M, k). Everything is checked before anything is added.
+        """
+        p = self._rows("pos", pos)
+        k = p.shape[1]
+        v = np.zeros_like(p) if vel is None else self._rows("vel", vel)
+        if v.shape != p.shape:
+            raise ValueError(f"vel has shape {v.shape[1:]} per system but pos has {p.shape[1:]}")
+        m = self._columns("mass", mass, k, minimum=0.0)
+        q = self._columns("charge", charge, k)
+        r = self._columns("radius", radius, k, minimum=0.0)
+        tst = self._flags("test", test, k)
+        pin = self._flags("pinned", pinned, k)
+        if self.n + k > self.capacity:
+            self._allocate(max(self.n + k, 2 * self.capacity))
+        s = slice(self.n, self.n + k)
+        self._pos[:, :, s] = p.transpose(0, 2, 1)
+        self._vel[:, :, s] = np.where(pin[:, :, None], 0.0, v).transpose(0, 2, 1)
+        self._mass[:, s] = m
+        self._charge[:, s] = q
+        self._radius[:, s] = r
+        self._test[:, s] = tst
+        self._pinned[:, s] = pin
+        self._active[:, s] = True
+        self.n += k
+        self._revision += 1  # per-slot parameters (a Thrust's) are laid out for the new count
+        return np.arange(s.start, s.stop)
+
+    def _rows(self, field, value):
+        arr = real_array(field, value, "numbers")
+        if arr.ndim == 2:
+            arr = np.broadcast_to(arr, (self.systems,) + arr.shape)
+        if arr.ndim != 3 or arr.shape[0] != self.systems or arr.shape[2] != self.dim:
+            raise ValueError(f"{field} must have shape (systems={self.systems}, k, dim={self.dim}) "
+                             f"or (k, {self.dim}), got shape {arr.shape}")
+        if not np.all(np.isfinite(arr)):
+            status = np.argwhere(~np.isfinite(arr))[0]
+            raise ValueError(f"{field} must be finite, got {arr[tuple(status)]!r} at system "
+                             f"{status[0]}, particle {status[1]} of the call")
+        return arr
+
+    def _columns(self, field, value, k, minimum=None):
+        arr = real_array(field, value, "a number")
+        try:
+            arr = np.broadcast_to(arr, (self.systems, k))
+        except ValueError:
+            raise ValueError(f"{field} must be a scalar, (k,) = ({k},) or (systems, k) = "
+                             f"({self.systems}, {k}), got shape {arr.shape}") from None
+        status = ~np.isfinite(arr)
+        if minimum is not None:
+            status |= arr < minimum
+        if status.any():
+            sys_, i = np.argwhere(status)[0]
+            rule = "finite" if minimum is None else f"finite and >= {minimum}"
+            raise ValueError(f"{field} must be {rule}, got {arr[sys_, i]!r} (system {sys_}, "
+                             f"particle {i} of the call)")
+        return arr
+
+    def _flags(self, field, value, k):
+        arr = np.asarray(value)
+        if arr.dtype != np.bool_:
+            raise TypeError(f"{field} must be True or False (or one per particle), got {value!r}")
+        try:
+            return np.broadcast_to(arr, (self.systems, k))
+        except ValueError:
+            raise ValueError(f"{field} must be a bool, (k,) or (systems, k), got shape "
+                             f"{arr.shape}") from None
+
+    def pin(self, i, system=None):
+        """Hold particle ``i`` still (in every system, or in ``system``): see ``Simulation.pin``."""
+        rows = self._system_rows(system)
+        i = self._index(i)
+        self._pinned[rows, i] = True
+        self._vel[rows, :, i] = 0.0
+
+    def unpin(self, i, system=None):
+        rows = self._system_rows(system)
+        self._pinned[rows, self._index(i)] = False
+
+    def _index(self, i):
+        if isinstance(i, bool) or not isinstance(i, numbers.Integral) or not 0 <= i < self.n:
+            raise ValueError(f"particle index must be an int in [0, {self.n}), got {i!r}")
+        return int(i)
+
+    def _system_rows(self, system):
+        if system is None:
+            return slice(None)
+        if isinstance(system, bool) or not isinstance(system, numbers.Integral) \
+                or not 0 <= system < self.systems:
+            raise ValueError(f"system must be an int in [0, {self.systems}), got {system!r}")
+        return int(system)
+
+    # -- forces ----------------------------------------------------------------------
+    @property
+    def forces(self):
+        return tuple(self._forces)
+
+    def add_force(self, force):
+        """Declare a force term for every system; it acts from the next step. Returns it."""
+        if not isinstance(force, Force):
+            raise TypeError(f"force must be an engine.forces term, got {force!r}")
+        if any(f is force for f in self._forces):
+            raise ValueError(f"{force!r} is already declared in this batch")
+        force._attach(self)
+        self._forces.append(force)
+        self._revision += 1
+        return force
+
+    def remove_force(self, force):
+        for k, f in enumerate(self._forces):
+            if f is force:
+                del self._forces[k]
+                force._sim = None
+                self._per_system = [(t, name) for t, name in self._per_system if t is not force]
+                self._revision += 1
+                return
+        raise ValueError(f"{force!r} is not declared in this batch")
+
+    def _slot(self, term, name):
+        """The ``slice`` of ``name`` in a system's parameter row, and its shape."""
+        self._current_model()
+        for k, f in enumerate(self._forces):
+            if f is term:
+                layout = self._layouts[k]
+                if name not in layout:
+                    raise ValueError(f"{type(term).__name__} has no parameter {name!r}; its "
+                                     f"parameters are {', '.join(layout)}")
+                start, shape = layout[name]
+                start += int(self._model.foff[k])
+                size = int(np.prod(shape, dtype=np.int64))
+                return slice(start, start + size), shape
+        raise ValueError(f"{term!r} is not declared in this batch")
+
+    def parameter(self, term, name):
+        """The packed values of ``term``'s parameter ``name`` in every system, (M, *shape)
+        (a copy; names are the term's ``LAYOUT``, e.g. ``"pos"`` of a PointMass)."""
+        cols, shape = self._slot(term, name)
+        return self._model.fp[:, cols].reshape((self.systems,) + shape).copy()
+
+    def set_parameter(self, term, name, values):
+        """Set ``term``'s parameter ``name`` per system: ``values`` of shape (M, *shape), or
+        *shape for all. From then on the parameter is per system: the term's own attribute
+        no longer overwrites it. Values are the packed ones (``softening_squared`` is the
+        square of the softening length) and must be finite."""
+        cols, shape = self._slot(term, name)
+        arr = real_array(name, values, "numbers")
+        try:
+            arr = np.broadcast_to(arr, (self.systems,) + shape)
+        except ValueError:
+            raise ValueError(f"{name} must have shape (systems={self.systems}, *{shape}) or "
+                             f"{shape}, got shape {arr.shape}") from None
+        if not np.all(np.isfinite(arr)):
+            raise ValueError(f"{name} must be finite, got {arr[~np.isfinite(arr)][0]!r}")
+        self._model.fp[:, cols] = arr.reshape(self.systems, -1)
+        self._mark_per_system(term, name)
+
+    def parameter_columns(self, term, name):
+        """``(start, stop)``: the columns of ``name`` in ``kernel_arguments()[1].fp`` rows, for
+        compiled code that writes the parameter itself every step (a ship's thrust); the
+        parameter becomes per system, as with ``set_parameter``."""
+        cols, _ = self._slot(term, name)
+        self._mark_per_system(term, name)
+        return cols.start, cols.stop
+
+    def _mark_per_system(self, term, name):
+        if not any(t is term and n == name for t, n in self._per_system):
+            self._per_system.append((term, name))
+
+    def _current_model(self):
+        key = (self._G, self._revision) + tuple(f._version for f in self._forces)
+        if key == self._model_key:
+            return self._model
+        model = pack(self._forces, self)
+        layouts = [term.layout(self) for term in self._forces]
+        for term, layout, f0, f1 in zip(self._forces, layouts, model.foff[:-1], model.foff[1:]):
+            declared = sum(int(np.prod(shape, dtype=np.int64)) for _, shape in layout.values())
+            if declared != f1 - f0:
+                raise RuntimeError(f"{type(term).__name__}.LAYOUT declares {declared} floats but "
+                                   f"the term packs {f1 - f0}: the declaration is wrong")
+        rows = np.repeat(model.fp[None, :], self.systems, axis=0)
+        for term, name in self._per_system:  # per-system values survive a re-pack
+            k = next(i for i, f in enumerate(self._forces) if f is term)
+            start, shape = layouts[k][name]
+            size = int(np.prod(shape, dtype=np.int64))
+            old_start, old_shape = self._old_slot(term, name)
+            if old_shape != shape:
+                raise ValueError(f"{type(term).__name__}.{name} was set per system with shape "
+                                 f"{old_shape}, and it now has shape {shape}; set it again")
+            new0 = int(model.foff[k]) + start
+            rows[:, new0:new0 + size] = self._model.fp[:, old_start:old_start + size]
+        self._model = Model(model.kinds, rows, model.foff, model.ip, model.ioff)
+        self._layouts = {k: layout for k, layout in enumerate(layouts)}
+        self._layout_terms = list(self._forces)
+        self._model_key = key
+        return self._model
+
+    def _old_slot(self, term, name):
+        """Where ``term.name`` sat in the previous packing (absolute column, shape)."""
+        for k, f in enumerate(self._layout_terms):
+            if f is term:
+                start, shape = self._layouts[k][name]
+                return int(self._model.foff[k]) + start, shape
+        raise ValueError(f"{term!r} was not packed before")
+
+    def kernel_arguments(self):
+        """``(state, model)`` with the system axis: ``State`` arrays of shape (M, dim, capacity)
+        and (M, capacity), ``Model.fp`` of shape (M, F); for compiled code of your own."""
+        state = State(self._pos, self._vel, self._mass, self._charge, self._radius, self._active,
+                      self._test, self._pinned, self.n, self._box)
+        return state, self._current_model()
+
+    # -- time ------------------------------------------------------------------------
+    def step(self, n=1):
+        """Advance every system by ``n`` steps in one compiled call (rk45: ``n`` accepted
+        steps each). A system that blows up keeps its last finite state and the call raises
+        ``SimulationError`` naming it; the other systems have taken their steps."""
+        n = step_count("n", n)
+        if not n:
+            return
+        state, model = self.kernel_arguments()
+        self._check_state(state)
+        if self._integrator != "rk45" and not np.all(np.isfinite(self._t + n * self._h)):
+            raise ValueError(f"{n} steps of {self._h[0]!r} take the time past the largest float; "
+                             "nothing was changed")
+        vdep = any(f.velocity_dependent for f in self._forces)
+        family, drifts, kicks = _family(self._integrator)
+        done = np.zeros(self.systems, dtype=np.int64)
+        status = np.full(self.systems, -1, dtype=np.int64)
+        h_before = self._h.copy()
+        advance_all(family, self._t, self._h, n, state, model, vdep, self._tolerance, drifts,
+                    kicks, done, status)
+        if family != RK45:
+            self._h[:] = h_before
+        self._steps += done
+        failed = np.flatnonzero(status != -1)
+        if failed.size:
+            m = int(failed[0])
+            code = int(status[m])
+            what = {STEP_COLLAPSED: "the rk45 step size collapsed",
+                    TIME_OVERFLOW: "the next rk45 step would take the time past the largest float"}
+            reason = what.get(code, f"particle {code} got a non-finite position or velocity")
+            raise SimulationError(
+                f"system {m} of {self.systems} failed at its step {int(self._steps[m])} from "
+                f"t={float(self._t[m])!r} with {self._integrator}: {reason}; its last finite "
+                f"state is kept ({failed.size} system(s) failed: {failed[:8].tolist()})",
+                step=int(self._steps[m]), time=float(self._t[m]),
+                particle=code if code >= 0 else None)
+
+    def _check_state(self, state):
+        n = self.n
+        pin = self._pinned[:, :n]
+        if pin.any():
+            self._vel[:, :, :n][np.broadcast_to(pin[:, None, :], (self.systems, self.dim, n))] = 0.0
+        for field, arr, minimum in (("pos", self._pos[:, :, :n], None), ("vel", self._vel[:, :, :n], None),
+                                    ("mass", self._mass[:, :n], 0.0),
+                                    ("charge", self._charge[:, :n], None),
+                                    ("radius", self._radius[:, :n], 0.0)):
+            status = ~np.isfinite(arr)
+            if minimum is not None:
+                status |= arr < minimum
+            if status.any():
+                where = tuple(int(x) for x in np.argwhere(status)[0])
+                m, i = where[0], where[-1]
+                raise ValueError(f"{field} of system {m}, particle {i} must be finite"
+                                 f"{'' if minimum is None else ' and >= 0'}, got "
+                                 f"{float(arr[where])!r} (written directly: bad input); "
+                                 "nothing was changed")
+
+    # -- diagnostics -----------------------------------------------------------------
+    def _moving(self):
+        return self._active & ~self._pinned
+
+    def _energies(self):
+        state, model = self.kernel_arguments()
+        kinetic = np.zeros(self.systems)
+        potential = np.zeros(self.systems)
+        energies(self._t, state, model, self._moving(), len(self._forces), kinetic, potential)
+        return kinetic, potential
+
+    def kinetic_energy(self):
+        """(M,) kinetic energy of each system's moving particles."""
+        return self._energies()[0]
+
+    def potential_energy(self):
+        """(M,) sum of each system's conservative potentials."""
+        return self._energies()[1]
+
+    def energy(self):
+        """(M,) total energy of each system."""
+        kinetic, potential = self._energies()
+        return kinetic + potential
+
+    def momentum(self):
+        """(M, dim) linear momentum of each system's moving particles."""
+        w = self._mass[:, : self.n] * self._moving()[:, : self.n]
+        return np.einsum("mi,mki->mk", w, self._vel[:, :, : self.n])
+
+    def __repr__(self):
+        return (f"Batch(systems={self.systems}, dim={self.dim}, integrator={self._integrator!r}, "
+                f"n={self.n}, forces={self._forces!r})")
+
+
+def _family(name):
+    """The compiled family of an integrator name, with splitting coefficients (or empty)."""
+    if name in splitting.SCHEMES:
+        drifts, kicks = splitting.coefficients(name)
+        return SPLITTING, drifts, kicks
+    empty = np.zeros(0)
+    return {"euler": EULER, "rk4": RK4, "rk45": RK45}[name], empty, empty
+
+
+__all__ = ["Batch", "advance_system", "step_system", "system_state", "system_model",
+           "SPLITTING", "EULER", "RK4", "RK45"]

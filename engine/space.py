@@ -1,0 +1,54 @@
+"""One periodic space: the torus [-L/2, L/2)^dim, its wrap and its nearest image.
+
+A simulation or batch declares its space once (``Simulation(box=L)``); every part of the engine
+that needs it uses these two functions: the drift wraps positions after moving them, and every
+pair force (gravity, Coulomb) and the game's collisions take separations by the nearest image.
+jax-md's ``space.periodic(side)`` (one displacement and one shift function shared by every
+energy; Schoenholz & Cubuk, NeurIPS 2020) is the model.
+
+    wrap(x, L)           = x - L floor(x / L + 1/2)       in [-L/2, L/2)
+    nearest_image(d, L)  = the same map applied to a separation d = x_j - x_i
+
+With ``L = 0`` (open space) both return their argument unchanged. Both are numba functions that
+take a float or a numpy array (from Python or from compiled code).
+"""
+import numpy as np
+from numba import njit
+
+from ._validate import optional, positive_float
+
+
+@njit(cache=True, error_model="numpy")
+def wrap(x, side):
+    """``x`` mapped onto [-side/2, side/2) (unchanged when ``side`` is 0)."""
+    if side > 0.0:
+        return x - side * np.floor(x / side + 0.5)
+    return x
+
+
+nearest_image = wrap  # the same map: a separation reduced to its shortest periodic image
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def image(x, side, half):
+    """``wrap`` for one number, inlined into compiled callers (the drift, the pair loops).
+
+    ``half`` is 1/2 in the precision of ``x`` (a float32 pair loop stays in float32)."""
+    if side > 0.0:
+        return x - side * np.floor(x / side + half)
+    return x
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def wrap_scalar(x, side):
+    """``wrap`` for one float64, inlined into compiled callers."""
+    return image(x, side, 0.5)
+
+
+def check_box(box):
+    """The side of a periodic space as a float (``None`` or 0 means open space: 0.0)."""
+    value = optional(positive_float)("box", box)
+    return 0.0 if value is None else value
+
+
+__all__ = ["wrap", "nearest_image", "image", "wrap_scalar", "check_box"]

@@ -1,0 +1,48 @@
+"""The arguments every compiled kernel takes, defined once: ``State``, ``Model``, ``Workspace``.
+
+Compiled code built on the engine (the game, learning environments, parameter sweeps) calls the
+force and integrator kernels with these three named tuples, which numba passes as plain
+structs (fields read without reference counting in the ``_nrt=False`` kernels):
+
+``State(pos, vel, mass, charge, radius, active, test, pinned, n, box)``
+    one system's particles: ``pos``/``vel`` of shape ``(dim, capacity)`` (component-major:
+    all x, then all y), the per-particle arrays of shape ``(capacity,)``, the ``n`` slots in
+    use, and the side of the periodic space (``0.0`` for open space; see ``engine.space``).
+    ``active``, ``test`` and ``pinned`` are booleans.
+``Model(kinds, fp, foff, ip, ioff)``
+    the packed force terms: term ``s`` has kind ``kinds[s]`` and parameters
+    ``fp[foff[s]:foff[s+1]]`` (float64) and ``ip[ioff[s]:ioff[s+1]]`` (int64); the names of
+    the float parameters are given by each term's ``layout`` (``engine.forces.base``).
+``Workspace(floats, ints, threads)``
+    scratch for the large-N pair kernels (``pairwise.workspace``) and whether they may start
+    a parallel region of their own (False inside a batch, whose systems already fill the cores).
+
+With these, a force kernel is ``accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work)`` and
+an integrator step is ``advance(t, h, steps, state, model, work, vdep, t_end, ...)``.
+"""
+from collections import namedtuple
+
+import numpy as np
+from numba import njit
+
+State = namedtuple("State", "pos vel mass charge radius active test pinned n box")
+Model = namedtuple("Model", "kinds fp foff ip ioff")
+Workspace = namedtuple("Workspace", "floats ints threads")
+
+EMPTY_WORKSPACE = Workspace(np.empty(0), np.empty(0, dtype=np.int64), False)
+
+
+@njit(cache=True, inline="always")
+def with_motion(state, pos, vel):
+    """The same particles at other positions and velocities (a Runge-Kutta stage)."""
+    return State(pos, vel, state.mass, state.charge, state.radius, state.active, state.test,
+                 state.pinned, state.n, state.box)
+
+
+@njit(cache=True, inline="always")
+def with_parameters(model, fp):
+    """The same terms with another float parameter row (one system of a batch)."""
+    return Model(model.kinds, fp, model.foff, model.ip, model.ioff)
+
+
+__all__ = ["State", "Model", "Workspace", "EMPTY_WORKSPACE", "with_motion", "with_parameters"]
