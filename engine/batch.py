@@ -123,6 +123,13 @@ def energies(t, state, model, moving, terms, kinetic, potential):
         potential[m] = out.sum()
 
 
+@njit(parallel=True, cache=True, error_model="numpy")
+def momenta(state, moving, out):
+    """Linear momentum of every system (``diagnostics.momentum`` per system)."""
+    for m in prange(state.pos.shape[0]):
+        out[m] = diagnostics.momentum(state.vel[m], state.mass[m], moving[m], state.n)
+
+
 class Batch:
     """M independent systems with the same force terms and particle slots (see the module).
 
@@ -312,7 +319,7 @@ class Batch:
         if status.any():
             sys_, i = np.argwhere(status)[0]
             rule = "finite" if minimum is None else f"finite and >= {minimum}"
-            raise ValueError(f"{field} must be {rule}, got {arr[sys_, i]!r} (system {sys_}, "
+            raise ValueError(f"{field} must be {rule}, got {float(arr[sys_, i])!r} (system {sys_}, "
                              f"particle {i} of the call)")
         return arr
 
@@ -410,7 +417,7 @@ class Batch:
             raise ValueError(f"{name} must have shape (systems={self.systems}, *{shape}) or "
                              f"{shape}, got shape {arr.shape}") from None
         if not np.all(np.isfinite(arr)):
-            raise ValueError(f"{name} must be finite, got {arr[~np.isfinite(arr)][0]!r}")
+            raise ValueError(f"{name} must be finite, got {float(arr[~np.isfinite(arr)][0])!r}")
         self._model.fp[:, cols] = arr.reshape(self.systems, -1)
         self._mark_per_system(term, name)
 
@@ -552,8 +559,10 @@ class Batch:
 
     def momentum(self):
         """(M, dim) linear momentum of each system's moving particles."""
-        w = self._mass[:, : self.n] * self._moving()[:, : self.n]
-        return np.einsum("mi,mki->mk", w, self._vel[:, :, : self.n])
+        state, _ = self.kernel_arguments()
+        out = np.zeros((self.systems, self.dim))
+        momenta(state, self._moving(), out)
+        return out
 
     def __repr__(self):
         return (f"Batch(systems={self.systems}, dim={self.dim}, integrator={self._integrator!r}, "

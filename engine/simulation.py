@@ -145,6 +145,11 @@ class Simulation:
         return self._particles.n
 
     @property
+    def capacity(self):
+        """Particle slots allocated (grows by doubling as particles are added)."""
+        return self._particles.capacity
+
+    @property
     def pos(self):
         """Positions, (N, dim): a writable view of the engine's state."""
         p = self._particles
@@ -476,6 +481,15 @@ class Simulation:
     def center_of_mass(self):
         p = self._particles
         return diagnostics.center_of_mass(p.pos, p.vel, p.mass, self._moving(), p.n)
+
+    def stable_dt(self):
+        """The largest stable |dt| for this integrator at the current state (code units):
+        the integrator's limit on omega h over the highest frequency of the declared springs
+        (and of close gravitating pairs); ``inf`` if nothing limits the step, 0.0 for
+        ``euler`` on any oscillation; ValueError for the adaptive ``rk45``. See
+        ``engine.stability``."""
+        from . import stability
+        return stability.stable_dt(self)
 
     # -- units -----------------------------------------------------------------------
     def _code(self, value, kind, field):

@@ -9,8 +9,9 @@ energy; Schoenholz & Cubuk, NeurIPS 2020) is the model.
     wrap(x, L)           = x - L floor(x / L + 1/2)       in [-L/2, L/2)
     nearest_image(d, L)  = the same map applied to a separation d = x_j - x_i
 
-With ``L = 0`` (open space) both return their argument unchanged. Both are numba functions that
-take a float or a numpy array (from Python or from compiled code).
+With ``L = 0`` (open space) both return their argument unchanged. ``wrap`` and
+``nearest_image`` take floats or numpy arrays from Python; compiled code inlines ``image`` (any
+float precision) or ``wrap_scalar`` (float64), the same formula.
 """
 import numpy as np
 from numba import njit
@@ -18,15 +19,20 @@ from numba import njit
 from ._validate import optional, positive_float
 
 
-@njit(cache=True, error_model="numpy")
 def wrap(x, side):
-    """``x`` mapped onto [-side/2, side/2) (unchanged when ``side`` is 0)."""
+    """``x`` (a float or an array) mapped onto [-side/2, side/2); unchanged when ``side`` is 0.
+
+    For Python callers (bots, drawing); compiled callers inline ``image``/``wrap_scalar``,
+    the same formula, bit for bit (a test holds them to it)."""
     if side > 0.0:
         return x - side * np.floor(x / side + 0.5)
     return x
 
 
-nearest_image = wrap  # the same map: a separation reduced to its shortest periodic image
+def nearest_image(d, side):
+    """The separation ``d`` (a float or an array, d = x_j - x_i) by its shortest periodic
+    image: ``wrap`` applied to a difference."""
+    return wrap(d, side)
 
 
 @njit(cache=True, error_model="numpy", inline="always")

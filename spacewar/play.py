@@ -26,6 +26,8 @@ from bisect import bisect_right
 
 import numpy as np
 
+from engine import space
+
 from . import core
 from .game import Game
 from .match import bot_seed
@@ -169,7 +171,7 @@ def _paint(pygame, surface, prims, fonts):
 
 
 def _wrap(d):
-    return d - np.floor(d + 0.5)
+    return space.wrap(d, 1.0)
 
 
 def _blend(snapshot, game, prev_pos, prev_active, alpha):

@@ -28,6 +28,7 @@ from itertools import product
 
 import numpy as np
 
+from engine import space
 from engine.atomic import atomic_write, check_output_path
 
 VIZ_HINT = "pip install -e '.[viz]'"
@@ -95,8 +96,8 @@ def _images(x, y, reach):
 
 
 def _torus_distance(a, b):
-    dx = (b[0] - a[0]) - math.floor(b[0] - a[0] + 0.5)
-    dy = (b[1] - a[1]) - math.floor(b[1] - a[1] + 0.5)
+    dx = space.nearest_image(b[0] - a[0], 1.0)
+    dy = space.nearest_image(b[1] - a[1], 1.0)
     return math.hypot(dx, dy)
 
 

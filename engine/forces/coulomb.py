@@ -8,6 +8,7 @@ Uncharged and inactive particles are skipped; test particles do take part (the t
 about gravity only).
 """
 import math
+import warnings
 
 from numba import njit
 
@@ -74,7 +75,8 @@ def potential(t, state, fp, f0, f1, ip, i0, i1):
 class Coulomb(Force):
     """Coulomb forces between all charged active particles; ``k`` is the Coulomb constant.
 
-    ``box``: side of a periodic (torus) domain; pairs then interact through their nearest image.
+    ``box`` (deprecated): side of a periodic domain for this term alone; declare the space
+    once instead (``Simulation(box=L)``), and pairs interact through their nearest image.
     """
 
     KIND = KIND
@@ -87,6 +89,10 @@ class Coulomb(Force):
         super().__init__()
         self.k = k
         self.softening = softening
+        if box is not None:
+            warnings.warn(f"{type(self).__name__}(box=...) is deprecated: declare the periodic space once, "
+                          "Simulation(box=L) or Batch(box=L), and every pair force, the drift "
+                          "and collisions use it", DeprecationWarning, stacklevel=3)
         self.box = box
 
     def _pack(self, sim):

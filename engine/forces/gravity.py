@@ -12,6 +12,7 @@ particles costs nothing: O(N_massive x N) for test particles around a few bodies
 ``pairwise`` runs instead (each pair visited from both ends; momentum to round-off per visit).
 """
 import math
+import warnings
 
 from numba import njit
 
@@ -146,7 +147,8 @@ class NBodyGravity(Force):
 
     ``G=None`` uses the simulation's ``G`` (1.0 without units). ``softening`` is the Plummer
     length eps >= 0; with eps = 0 two coincident bodies make the step raise SimulationError.
-    ``box``: side of a periodic (torus) domain; pairs then interact through their nearest image.
+    ``box`` (deprecated): side of a periodic domain for this term alone; declare the space
+    once instead (``Simulation(box=L)``), and pairs interact through their nearest image.
     ``precision="float32"``: the vectorised kernel (from ``pairwise.PARALLEL_MIN`` bodies on)
     sums the pairs in single precision, in a frame centred on the bodies' mean position and
     scaled by their extent (so any units work): about 2 times faster per step. Forces come out
@@ -168,6 +170,10 @@ class NBodyGravity(Force):
         super().__init__()
         self.G = G
         self.softening = softening
+        if box is not None:
+            warnings.warn(f"{type(self).__name__}(box=...) is deprecated: declare the periodic space once, "
+                          "Simulation(box=L) or Batch(box=L), and every pair force, the drift "
+                          "and collisions use it", DeprecationWarning, stacklevel=3)
         self.box = box
         self.precision = precision
 

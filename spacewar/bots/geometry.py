@@ -23,21 +23,25 @@ import math
 
 import numpy as np
 
+from engine import space
 from engine.analytic import kepler
+
+#: side of the game's torus (positions in [-0.5, 0.5))
+SIDE = 1.0
 
 TWO_PI = 2.0 * math.pi
 
 
 # -- torus and angles -------------------------------------------------------------------
 def wrap(x):
-    """Onto the torus coordinate range [-0.5, 0.5) (arrays or floats)."""
-    return x - np.floor(x + 0.5)
+    """Onto the torus coordinate range [-0.5, 0.5) (arrays or floats): ``engine.space.wrap``
+    with the game's side of 1."""
+    return space.wrap(x, SIDE)
 
 
 def torus_delta(a, b):
-    """The shortest vector from a to b on the unit torus."""
-    d = np.asarray(b, dtype=float) - np.asarray(a, dtype=float)
-    return d - np.floor(d + 0.5)
+    """The shortest vector from a to b on the unit torus (``engine.space.nearest_image``)."""
+    return space.nearest_image(np.asarray(b, dtype=float) - np.asarray(a, dtype=float), SIDE)
 
 
 def angle_diff(target, heading):

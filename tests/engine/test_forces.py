@@ -297,16 +297,56 @@ def test_point_mass_acts_only_on_listed_particles():
         Simulation().add_force(forces.PointMass(particles=[5]))
 
 
-@pytest.mark.parametrize("make", [lambda: forces.NBodyGravity(box=10.0),
-                                  lambda: forces.Coulomb(k=-1.0, box=10.0)])
-def test_periodic_box_uses_the_nearest_image(make):
+@pytest.mark.parametrize("make", [lambda: forces.NBodyGravity(), lambda: forces.Coulomb(k=-1.0)])
+def test_periodic_space_uses_the_nearest_image(make):
     # bodies at x = -4.5 and x = 4.5 on a torus of side 10 are 1 apart through the edge
-    sim = Simulation(dim=2)
+    sim = Simulation(dim=2, box=10.0)
     sim.add_many(mass=1.0, pos=[(-4.5, 0.0), (4.5, 0.0)], charge=1.0)
     sim.add_force(make())
     a = accel(sim)
     np.testing.assert_allclose(a, [(-1.0, 0.0), (1.0, 0.0)], rtol=1e-14)
     assert sim.potential_energy() == pytest.approx(-1.0)
+
+
+@pytest.mark.parametrize("cls, kwargs", [(forces.NBodyGravity, {}), (forces.Coulomb, {"k": -1.0})])
+def test_a_forces_own_box_still_works_with_a_deprecation(cls, kwargs):
+    with pytest.warns(DeprecationWarning, match=r"box=\.\.\.\) is deprecated.*Simulation\(box=L\)"):
+        term = cls(box=10.0, **kwargs)
+    old = Simulation(dim=2)
+    old.add_many(mass=1.0, pos=[(-4.5, 0.0), (4.5, 0.0)], charge=1.0)
+    old.add_force(term)
+    new = Simulation(dim=2, box=10.0)
+    new.add_many(mass=1.0, pos=[(-4.5, 0.0), (4.5, 0.0)], charge=1.0)
+    new.add_force(cls(**kwargs))
+    np.testing.assert_array_equal(accel(old), accel(new))
+    assert old.potential_energy() == new.potential_energy()
+
+
+def test_the_drift_wraps_positions_onto_the_periodic_space():
+    sim = Simulation(dim=2, integrator="leapfrog", dt=0.5, box=2.0)
+    sim.add(mass=1.0, pos=(0.9, -0.9), vel=(1.0, -1.0))
+    sim.step()  # 0.9 + 0.5 = 1.4 -> -0.6 through the edge
+    np.testing.assert_allclose(sim.pos[0], (-0.6, 0.6), rtol=1e-15)
+    assert np.all(sim.pos >= -1.0) and np.all(sim.pos < 1.0)
+    for integrator in engine_integrators():
+        sim = Simulation(dim=2, integrator=integrator, dt=0.25, box=2.0)
+        sim.add(mass=1.0, pos=(0.0, 0.0), vel=(3.0, 1.7))
+        sim.add_force(forces.UniformGravity(g=(0.0, 0.0)))
+        sim.step(40)
+        assert np.all(sim.pos >= -1.0) and np.all(sim.pos < 1.0), integrator
+
+
+def engine_integrators():
+    import engine
+    return engine.INTEGRATORS
+
+
+def test_box_is_checked():
+    with pytest.raises(ValueError, match="box must be > 0, got -1.0"):
+        Simulation(box=-1.0)
+    with pytest.raises(TypeError, match="box must be a real number, got 'x'"):
+        Simulation(box="x")
+    assert Simulation(box=None).box == 0.0
 
 
 def test_gravity_open_space_fast_path_equals_the_general_loop():
@@ -316,10 +356,10 @@ def test_gravity_open_space_fast_path_equals_the_general_loop():
     fast = Simulation(dim=3)
     fast.add_many(mass=mass, pos=pos)
     fast.add_force(forces.NBodyGravity(G=1.3, softening=0.01))
-    general = Simulation(dim=3)
+    general = Simulation(dim=3, box=1e6)
     general.add_many(mass=mass, pos=pos)
-    # a periodic box far larger than the system takes the general branchy loop, same numbers
-    general.add_force(forces.NBodyGravity(G=1.3, softening=0.01, box=1e6))
+    # a periodic space far larger than the system takes the general branchy loop, same numbers
+    general.add_force(forces.NBodyGravity(G=1.3, softening=0.01))
     np.testing.assert_allclose(accel(fast), accel(general), rtol=1e-14)
     general.add(mass=0.0, pos=(5.0, 0.0, 0.0), test=True)  # a test particle: general path too
     np.testing.assert_allclose(accel(general)[:7], accel(fast), rtol=1e-14)

@@ -61,9 +61,13 @@ def test_fused_path_is_taken_only_for_its_case():
     sim.add_many(mass=1.0, pos=np.eye(3), test=[False, False, True])
     sim.add_force(forces.NBodyGravity())
     assert not _uses_fused(sim)
-    sim = Simulation(dim=3)
+    sim = Simulation(dim=3, box=10.0)
     sim.add_many(mass=1.0, pos=np.eye(3))
-    sim.add_force(forces.NBodyGravity(box=10.0))
+    sim.add_force(forces.NBodyGravity())
+    assert not _uses_fused(sim)
+    sim = Simulation(dim=3)
+    sim.add_many(mass=1.0, pos=np.eye(3), pinned=[True, False, False])
+    sim.add_force(forces.NBodyGravity())
     assert not _uses_fused(sim)
 
 

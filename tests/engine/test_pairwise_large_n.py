@@ -48,10 +48,10 @@ def test_gravity_large_n_matches_a_direct_sum(dim, n):
 @pytest.mark.parametrize("n", SIZES)
 def test_coulomb_large_n_matches_a_direct_sum_on_a_torus(n):
     rng = np.random.default_rng(7)
-    sim = Simulation(dim=2)
+    sim = Simulation(dim=2, box=10.0)
     sim.add_many(mass=rng.uniform(0.5, 2.0, n), pos=rng.uniform(-5, 5, size=(n, 2)),
                  charge=rng.choice([-1.0, 0.0, 1.0], n))
-    sim.add_force(forces.Coulomb(k=0.3, softening=0.05, box=10.0))
+    sim.add_force(forces.Coulomb(k=0.3, softening=0.05))
     a = accel(sim)
     charged = np.flatnonzero(sim.charge != 0)
     field = numpy_field(sim.pos, sim.charge, 0.0025, charged, charged, box=10.0)
@@ -121,9 +121,9 @@ def test_float32_gravity_is_the_float64_field_to_single_precision(n, box):
     masses = rng.uniform(0.5, 2.0, n)
     fields = {}
     for precision in ("float64", "float32"):
-        sim = Simulation(dim=3)
+        sim = Simulation(dim=3, box=box)
         sim.add_many(mass=masses, pos=pos, test=np.arange(n) % 7 == 3)
-        sim.add_force(forces.NBodyGravity(softening=0.01, box=box, precision=precision))
+        sim.add_force(forces.NBodyGravity(softening=0.01, precision=precision))
         fields[precision] = accel(sim)
     exact, single = fields["float64"], fields["float32"]
     scale = np.linalg.norm(exact, axis=1)

@@ -28,7 +28,7 @@ def test_capacity_grows_without_losing_state_or_forces():
             sim.step(2)
         return sim
     grown, roomy = run(2), run(64)
-    assert grown.n == 50 and grown._particles.capacity >= 50 and roomy._particles.capacity == 64
+    assert grown.n == 50 and grown.capacity >= 50 and roomy.capacity == 64
     assert grown.pos.tobytes() == roomy.pos.tobytes()
     assert grown.vel.tobytes() == roomy.vel.tobytes()
 
