@@ -222,6 +222,7 @@ class Game:
         live = [b for b in range(2, 2 + 2 * t) if self.active[m, b]]
         return {"frame": int(self.match_state[m, core.FRAME]), "round_frame": int(self.match_state[m, core.ROUND_FRAME]),
                 "round": int(self.match_state[m, core.ROUNDS_PLAYED]), "scores": self.scores[m].tolist(),
+                "frames_in_finished_rounds": int(self.match_state[m, core.ROUND_FRAMES_TOTAL]),
                 "ships": ships,
                 "torpedoes": [{"pos": self.pos[m, :, b].tolist(), "owner": (b - 2) // t} for b in live],
                 "star": self.rules.effective_star_mu > 0, "over": bool(self.match_state[m, core.OVER])}
