@@ -130,16 +130,32 @@ def index_array(name, value, width=None):
 
 
 def step_count(name, value, minimum=0):
-    """An int step count in ``[minimum, MAX_STEPS]``; bools, floats and text are refused."""
+    """An int step count in ``[minimum, MAX_STEPS]``.
+
+    Bools, floats, text and None are a TypeError (not a count at all, like text given as a
+    number to :func:`finite_float`); a count out of range is a ValueError.
+    """
     if isinstance(value, _BOOLS) or not isinstance(value, numbers.Integral):
-        raise ValueError(f"{name} must be an int >= {minimum}, got {value!r} "
-                         f"({type(value).__name__})")
+        raise TypeError(f"{name} must be an int >= {minimum}, got {value!r} "
+                        f"({type(value).__name__})")
     value = int(value)
     if value < minimum:
         raise ValueError(f"{name} must be an int >= {minimum}, got {value!r}")
     if value > MAX_STEPS:
         raise ValueError(f"{name} must be at most 2**62 = {MAX_STEPS} steps per call, got {value!r}")
     return value
+
+
+def finite_array(name, value, what="a number or an array of numbers"):
+    """``value`` as a new float64 array (any shape) of finite numbers.
+
+    Text, booleans and complex numbers are a TypeError (see :func:`real_array`); nan or inf
+    anywhere is a ValueError.
+    """
+    arr = real_array(name, value, what)
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"{name} must be finite, got {value!r}")
+    return arr
 
 
 def vector(name, value, dim=None):

@@ -11,8 +11,11 @@ plus :func:`orbital_elements`, a summary of the conic a state lies on.
 
 Layout
 ------
-Each public function validates its input (raising :class:`ValueError` that
-names the offending argument) and then calls a numba ``@njit`` core that works
+Each public function validates its input with the engine's shared checks
+(``engine._validate``: :class:`TypeError` for text, booleans, complex numbers or
+None given as a number, :class:`ValueError` for non-finite or out-of-range
+values and bad shapes, both naming the offending argument and its value) and
+then calls a numba ``@njit`` core that works
 on plain floats and float64 arrays.  The cores are exported so that other
 compiled code -- a game's step function, a compiled bot -- can call them
 directly.  They do *no* validation: feed them finite values, ``mu > 0`` and a
@@ -56,6 +59,8 @@ from collections import namedtuple
 
 import numpy as np
 from numba import njit
+
+from ._validate import finite_array, nonnegative_float, positive_float, vector
 
 __all__ = [
     # public, validating API
@@ -664,38 +669,9 @@ def ballistic_step(p0, v0, g, t, p_out, v_out):
 # ---------------------------------------------------------------------------
 
 
-def _real_array(name, value):
-    """``value`` as a float64 array; ValueError naming ``name`` otherwise."""
-    try:
-        raw = np.asarray(value)
-    except Exception as exc:  # ragged lists and the like
-        raise ValueError(f"{name} must be a real number or array, got {value!r}") from exc
-    # Strings and complex numbers would otherwise be coerced or fail obscurely.
-    if raw.dtype.kind not in "biuf":
-        raise ValueError(f"{name} must be a real number or array, got {value!r}")
-    arr = raw.astype(np.float64)
-    if not np.all(np.isfinite(arr)):
-        raise ValueError(f"{name} must be finite, got {value!r}")
-    return arr
-
-
-def _real_scalar(name, value):
-    arr = _real_array(name, value)
-    if arr.ndim != 0:
-        raise ValueError(f"{name} must be a scalar, got {value!r}")
-    return float(arr)
-
-
-def _state_vector(name, value):
-    arr = _real_array(name, value)
-    if arr.ndim != 1 or arr.shape[0] not in (2, 3):
-        raise ValueError(f"{name} must be a vector of length 2 or 3, got {value!r}")
-    return np.ascontiguousarray(arr)
-
-
 def _times(name, value):
     """Returns ``(array, is_scalar)``; ``array`` is 0-d or 1-D float64."""
-    arr = _real_array(name, value)
+    arr = finite_array(name, value, "a time or a 1-D array of times")
     if arr.ndim > 1:
         raise ValueError(f"{name} must be a scalar or a 1-D array of times, got {value!r}")
     # (np.ascontiguousarray would promote a 0-d array to 1-D.)
@@ -703,13 +679,11 @@ def _times(name, value):
 
 
 def _kepler_inputs(r0, v0, mu):
-    r0a = _state_vector("r0", r0)
-    v0a = _state_vector("v0", v0)
+    r0a = vector("r0", r0)
+    v0a = vector("v0", v0)
     if v0a.shape != r0a.shape:
         raise ValueError(f"v0 must have the same length as r0 ({r0a.shape[0]}), got {v0!r}")
-    mu_f = _real_scalar("mu", mu)
-    if not mu_f > 0.0:
-        raise ValueError(f"mu must be positive, got {mu!r}")
+    mu_f = positive_float("mu", mu)
     if not np.any(r0a != 0.0):
         raise ValueError(f"r0 must have non-zero length, got {r0!r}")
     return r0a, v0a, mu_f
@@ -732,12 +706,13 @@ def ballistic(p0, v0, g, t):
     or a 1-D array of times, giving arrays with a leading time axis
     ``(len(t),) + shape`` -- handy for drawing a predicted path.
 
-    Raises ValueError, naming the argument, for non-finite or non-real
-    input, shapes that do not broadcast, or ``t`` with more than one axis.
+    Raises TypeError for text, booleans or complex numbers, and ValueError
+    for non-finite input, shapes that do not broadcast, or ``t`` with more
+    than one axis; both name the argument and show its value.
     """
-    p0a = _real_array("p0", p0)
-    v0a = _real_array("v0", v0)
-    ga = _real_array("g", g)
+    p0a = finite_array("p0", p0)
+    v0a = finite_array("v0", v0)
+    ga = finite_array("g", g)
     ta, _ = _times("t", t)
     try:
         shape = np.broadcast_shapes(p0a.shape, v0a.shape, ga.shape)
@@ -790,9 +765,10 @@ def kepler(r0, v0, mu, t):
     for an array of times.  The compiled core is :func:`kepler_propagate`
     (and :func:`kepler_step` for in-place updates).
 
-    Raises ValueError naming the argument for: non-finite or non-real
-    entries; ``r0``/``v0`` not of length 2 or 3 or of different lengths;
-    ``mu <= 0``; ``r0`` of zero length; ``t`` with more than one axis.
+    Raises TypeError for text, booleans or complex numbers, and ValueError
+    for: non-finite entries; ``r0``/``v0`` not of length 2 or 3 or of
+    different lengths; ``mu <= 0``; ``r0`` of zero length; ``t`` with more
+    than one axis.  Both name the argument and show its value.
     """
     r0a, v0a, mu_f = _kepler_inputs(r0, v0, mu)
     ta, scalar = _times("t", t)
@@ -815,17 +791,14 @@ def harmonic_oscillator(x0, v0, omega, t, zeta=0.0):
     ``t`` is a scalar or a 1-D array of times (leading time axis in the
     output).  Returns ``(x, v)``.
 
-    Raises ValueError naming the argument for non-finite or non-real input,
-    ``omega <= 0``, ``zeta < 0`` or incompatible shapes.
+    Raises TypeError for text, booleans or complex numbers, and ValueError
+    for non-finite input, ``omega <= 0``, ``zeta < 0`` or incompatible
+    shapes; both name the argument and show its value.
     """
-    x0a = _real_array("x0", x0)
-    v0a = _real_array("v0", v0)
-    omega_f = _real_scalar("omega", omega)
-    if not omega_f > 0.0:
-        raise ValueError(f"omega must be positive, got {omega!r}")
-    zeta_f = _real_scalar("zeta", zeta)
-    if zeta_f < 0.0:
-        raise ValueError(f"zeta must be non-negative, got {zeta!r}")
+    x0a = finite_array("x0", x0)
+    v0a = finite_array("v0", v0)
+    omega_f = positive_float("omega", omega)
+    zeta_f = nonnegative_float("zeta", zeta)
     ta, scalar = _times("t", t)
     try:
         shape = np.broadcast_shapes(x0a.shape, v0a.shape)

@@ -23,17 +23,21 @@ reverse (negative ``time_scale``), and never reads wall time unless asked to:
 so replays and tests are deterministic.  Only ``tick()`` with no argument reads
 the ``clock`` callable (``time.perf_counter`` by default).
 
-Only the standard library is imported.  ``interpolate`` works on anything that
-supports ``+``, ``-`` and multiplication by a float, e.g. numpy arrays.
+Inputs are checked by the engine's shared helpers (``engine._validate``), so a bad
+value raises what it raises anywhere in the engine: TypeError for text, booleans or None
+given as a number, ValueError for a non-finite or out-of-range number, both naming the
+field and the value.  ``interpolate`` works on anything that supports ``+``, ``-`` and
+multiplication by a float, e.g. numpy arrays.
 """
 
 from __future__ import annotations
 
 import math
-import numbers
 import time
 from fractions import Fraction
 from typing import Any, Callable, Optional
+
+from ._validate import finite_float, nonnegative_float, positive_float, step_count
 
 __all__ = ["FixedStepClock", "STEP_TOLERANCE"]
 
@@ -43,25 +47,6 @@ __all__ = ["FixedStepClock", "STEP_TOLERANCE"]
 STEP_TOLERANCE = 1e-9
 
 _STEP_TOLERANCE_Q = Fraction(STEP_TOLERANCE)
-
-
-def _is_real_number(value: Any) -> bool:
-    """True for ints/floats (and numpy scalars), False for bools and others.
-
-    ``bool`` is a subclass of ``int``; ``True`` as a time step or a frame time
-    is almost certainly a bug, so it is rejected rather than read as 1.
-    """
-    return isinstance(value, numbers.Real) and not isinstance(value, bool)
-
-
-def _finite_float(field: str, value: Any) -> float:
-    """Return ``value`` as a finite float or raise ValueError naming ``field``."""
-    if not _is_real_number(value):
-        raise ValueError(f"{field} must be a real number, got {value!r}")
-    result = float(value)
-    if not math.isfinite(result):
-        raise ValueError(f"{field} must be finite, got {value!r}")
-    return result
 
 
 class FixedStepClock:
@@ -99,30 +84,19 @@ class FixedStepClock:
         max_steps_per_frame: int = 8,
         clock: Optional[Callable[[], float]] = None,
     ) -> None:
-        dt_f = _finite_float("dt", dt)
-        if dt_f <= 0.0:
-            raise ValueError(f"dt must be positive, got {dt!r}")
-        if not isinstance(max_steps_per_frame, numbers.Integral) or isinstance(
-            max_steps_per_frame, bool
-        ):
-            raise ValueError(
-                f"max_steps_per_frame must be an int, got {max_steps_per_frame!r}"
-            )
-        if max_steps_per_frame < 1:
-            raise ValueError(
-                f"max_steps_per_frame must be >= 1, got {max_steps_per_frame!r}"
-            )
+        dt_f = positive_float("dt", dt)
+        max_steps = step_count("max_steps_per_frame", max_steps_per_frame, minimum=1)
         if clock is None:
             clock = time.perf_counter
         if not callable(clock):
-            raise ValueError(f"clock must be callable, got {clock!r}")
+            raise TypeError(f"clock must be callable, got {clock!r} ({type(clock).__name__})")
 
         self._dt = dt_f
         # Exact rational copy of the float dt (every float is a dyadic
         # rational, so Fraction(float) loses nothing).
         self._dt_q = Fraction(dt_f)
-        self._time_scale = _finite_float("time_scale", time_scale)
-        self._max_steps = int(max_steps_per_frame)
+        self._time_scale = finite_float("time_scale", time_scale)
+        self._max_steps = max_steps
         self._clock = clock
         self._paused = False
 
@@ -164,7 +138,7 @@ class FixedStepClock:
     def time_scale(self, value: float) -> None:
         # The accumulator is left alone: it holds simulated time already owed,
         # which does not change because the rate of future time changes.
-        self._time_scale = _finite_float("time_scale", value)
+        self._time_scale = finite_float("time_scale", value)
 
     # ------------------------------------------------------------------
     # Pause / resume
@@ -243,7 +217,7 @@ class FixedStepClock:
     def _read_wall_elapsed(self) -> float:
         """Wall seconds since the previous clock-driven tick (0 on the first)."""
         now = self._clock()
-        now_f = _finite_float("clock()", now)
+        now_f = finite_float("clock()", now)
         last, self._last_wall = self._last_wall, now_f
         if last is None:
             return 0.0
@@ -298,9 +272,7 @@ class FixedStepClock:
         if wall_elapsed is None:
             elapsed = self._read_wall_elapsed()
         else:
-            elapsed = _finite_float("wall_elapsed", wall_elapsed)
-            if elapsed < 0.0:
-                raise ValueError(f"wall_elapsed must be >= 0, got {wall_elapsed!r}")
+            elapsed = nonnegative_float("wall_elapsed", wall_elapsed)
             # An explicit elapsed time covers the interval since the previous
             # tick, so a later clock-driven tick must not count it again.
             self._last_wall = None
@@ -348,7 +320,7 @@ class FixedStepClock:
         simulation's; a mismatch raises ValueError before any time is
         consumed.  Returns the signed step count (0: ``sim`` is not touched).
         """
-        sim_dt = _finite_float("sim.dt", sim.dt)
+        sim_dt = finite_float("sim.dt", sim.dt)
         if not math.isclose(abs(sim_dt), self._dt, rel_tol=STEP_TOLERANCE, abs_tol=0.0):
             raise ValueError(
                 f"sim.dt must be +/-{self._dt!r} to match the clock, got {sim.dt!r}"

@@ -5,13 +5,14 @@ The PDP-1 screen was 1024 points across, so one point is 1/1024 of the arena. Ea
 ships move as in the original: velocity += thrust + gravity, then position += velocity, which
 is the engine's ``symplectic_euler`` with dt = 1 frame.
 
-Frame counts come from the version 3.1 source as summarised in
-``shared/reference/spacewar-1962.md`` (reload 16, torpedo life 96, 32 torpedoes, 8 hyperspace
-jumps of 32 frames with 128 to recharge, break-up risk k/8 on jump k, 192 frames after a
-round, about 100 frames for a full turn, about 1000 frames of fuel, a diamond hit test of 12
-and 18 points). Accelerations and speeds are chosen in the same proportions as the original's
-play: the heavy star out-pulls full thrust only close in, a torpedo crosses a third of the
-arena in its lifetime.
+Frame counts come from the original program: Spacewar! version 3.1 for the PDP-1 (Steve
+Russell et al., MIT, listing dated 24 September 1962), as run and explained by Norbert
+Landsteiner's emulation and write-up at https://www.masswerk.at/spacewar/ (reload 16, torpedo
+life 96, 32 torpedoes, 8 hyperspace jumps of 32 frames with 128 to recharge, break-up risk k/8
+on jump k, 192 frames after a round, about 100 frames for a full turn, about 1000 frames of
+fuel, a diamond hit test of 12 and 18 points). Accelerations and speeds are chosen in the same
+proportions as the original's play: the heavy star out-pulls full thrust only close in, a
+torpedo crosses a third of the arena in its lifetime.
 
 Sense-switch options: ``star`` heavy / light (1/4) / none, ``star_kills`` (else the ship is
 moved to the corner at rest), ``angular_momentum``, ``single_shot``. Modes beyond 1962:

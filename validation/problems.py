@@ -4,14 +4,18 @@ A :class:`Problem` is plain data (picklable, so worker processes can receive it)
 turns it into an ``engine.Simulation``; ``validation.reference`` turns it into a REBOUND
 simulation or a reference solution.
 
-Sources of the initial conditions and published facts are in
-``/work/shared/reference/integrator-references.md``:
+Sources of the initial conditions and published facts:
 
-- Kepler problem (Hairer, Lubich & Wanner, *Geometric Numerical Integration*, sec. I.2):
-  q(0) = (1 - e, 0), p(0) = (0, sqrt((1 + e)/(1 - e))), H = -1/2, period 2 pi.
-- Figure-eight choreography (Chenciner & Montgomery 2000, Simo's data), period 6.32591398.
-- Pythagorean three-body problem (Burrau 1913; Szebehely & Peters 1967), E0 = -769/60; the
-  lightest body (m = 3) escapes and the other two leave as a binary.
+- Kepler problem (E. Hairer, C. Lubich, G. Wanner, *Geometric Numerical Integration*, 2nd ed.,
+  Springer 2006, sec. I.2): q(0) = (1 - e, 0), p(0) = (0, sqrt((1 + e)/(1 - e))), H = -1/2,
+  period 2 pi.
+- Figure-eight choreography (A. Chenciner, R. Montgomery, "A remarkable periodic solution of
+  the three-body problem in the case of equal masses", Annals of Mathematics 152, 2000, with
+  C. Simo's initial data), period 6.32591398.
+- Pythagorean three-body problem (C. Burrau, Astronomische Nachrichten 195, 1913; V. Szebehely,
+  C. F. Peters, "Complete solution of a general problem of three bodies", Astronomical
+  Journal 72, 1967), E0 = -769/60; the lightest body (m = 3) escapes and the other two leave as
+  a binary.
 - Outer solar system (Hairer, Lubich & Wanner, sec. I.2.4) in AU, days and solar masses with
   G = 2.95912208286e-4.
 """

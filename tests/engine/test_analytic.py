@@ -663,8 +663,6 @@ BAD_CALLS = [
     (kepler, ([1.0], [0.0], 1.0, 1.0), {}, "r0"),
     (kepler, (R0, [0.0, 1.0, 0.0], 1.0, 1.0), {}, "v0"),
     (kepler, (R0, [0.0], 1.0, 1.0), {}, "v0"),
-    (kepler, ("ab", V0, 1.0, 1.0), {}, "r0"),
-    (kepler, (R0, V0, 1.0 + 1.0j, 1.0), {}, "mu"),
     (orbital_elements, (R0, V0, -2.0), {}, "mu"),
     (orbital_elements, ([0.0, 0.0], V0, 1.0), {}, "r0"),
     (orbital_elements, (R0, [NAN, 1.0], 1.0), {}, "v0"),
@@ -692,4 +690,27 @@ BAD_CALLS = [
 )
 def test_bad_input_raises_value_error_naming_argument(func, args, kwargs, name):
     with pytest.raises(ValueError, match=rf"\b{name}\b"):
+        func(*args, **kwargs)
+
+
+# Text, booleans and complex numbers are not real numbers: TypeError, as everywhere in the
+# engine (engine._validate).
+BAD_TYPES = [
+    (kepler, ("ab", V0, 1.0, 1.0), {}, "r0"),
+    (kepler, (R0, V0, 1.0 + 1.0j, 1.0), {}, "mu"),
+    (kepler, (R0, V0, True, 1.0), {}, "mu"),
+    (kepler, (R0, V0, 1.0, "1"), {}, "t"),
+    (harmonic_oscillator, (1.0, 0.0, 1.0, 1.0), {"zeta": None}, "zeta"),
+    (ballistic, (R0, V0, [0.0, True], 1.0), {}, "g"),
+]
+
+
+@pytest.mark.parametrize(
+    "func,args,kwargs,name",
+    BAD_TYPES,
+    ids=[f"{c[0].__name__}-{c[3]}-{i}" for i, c in enumerate(BAD_TYPES)],
+)
+def test_input_that_is_not_a_real_number_raises_type_error_naming_argument(func, args, kwargs,
+                                                                           name):
+    with pytest.raises(TypeError, match=rf"\b{name}\b"):
         func(*args, **kwargs)

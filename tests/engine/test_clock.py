@@ -440,8 +440,16 @@ def test_clock_going_backwards_raises():
 # ----------------------------------------------------------------------
 # Validation
 # ----------------------------------------------------------------------
-def _raises_naming(field, value, fn):
-    with pytest.raises(ValueError) as info:
+def _not_a_number(value):
+    """Text, booleans and None are not numbers: the engine's checks raise TypeError for them
+    (a number out of range or non-finite is a ValueError), like Simulation does."""
+    return value is None or isinstance(value, (str, bool))
+
+
+def _raises_naming(field, value, fn, error=None):
+    if error is None:
+        error = TypeError if _not_a_number(value) else ValueError
+    with pytest.raises(error) as info:
         fn()
     message = str(info.value)
     assert field in message
@@ -455,7 +463,10 @@ def test_bad_dt_raises(dt):
 
 @pytest.mark.parametrize("cap", [0, -1, 2.5, 8.0, True, "8", None])
 def test_bad_max_steps_raises(cap):
-    _raises_naming("max_steps_per_frame", cap, lambda: FixedStepClock(0.01, max_steps_per_frame=cap))
+    # A float is not a step count either (TypeError, as Simulation.step(1.5)).
+    error = TypeError if _not_a_number(cap) or isinstance(cap, float) else ValueError
+    _raises_naming("max_steps_per_frame", cap,
+                   lambda: FixedStepClock(0.01, max_steps_per_frame=cap), error)
 
 
 @pytest.mark.parametrize("scale", [math.nan, math.inf, -math.inf, "1", None, False])
@@ -491,7 +502,7 @@ def test_bad_wall_elapsed_raises_even_when_paused():
 
 
 def test_non_callable_clock_raises():
-    _raises_naming("clock", 3.0, lambda: FixedStepClock(0.01, clock=3.0))
+    _raises_naming("clock", 3.0, lambda: FixedStepClock(0.01, clock=3.0), TypeError)
 
 
 def test_numpy_scalars_are_accepted():
