@@ -28,6 +28,7 @@ Compiled code of your own (a game's frame) takes ``batch.kernel_arguments()``: a
 ``(M, F)``; ``system_state(state, m)`` and ``system_model(model, m)`` give one system's
 named tuples, and ``advance_system`` steps it with a splitting scheme.
 """
+import math
 import numbers
 
 import numpy as np
@@ -96,20 +97,56 @@ def _workspace(n):
     return Workspace(np.empty(0), np.empty(0, dtype=np.int64), False)
 
 
+#: systems are handed to the threads in this many chunks at most (one scratch space each)
+CHUNKS = 256
+
+
 @njit(parallel=True, cache=True, error_model="numpy")
 def advance_all(family, t, h, steps, state, model, vdep, tol, drifts, kicks, done, status):
-    """Every system by ``steps`` steps, whole systems spread over the threads.
+    """Every system by ``steps`` steps, whole systems spread over the threads in chunks (each
+    chunk with its own scratch space; which thread runs a chunk changes no result).
 
-    ``t`` and ``h`` (one per system) are updated in place; ``done[m]`` and ``status[m]`` get each
-    system's completed steps and failure code (-1 for success; see ``integrators.common``)."""
-    for m in prange(state.pos.shape[0]):
+    ``t`` and ``h`` (one per system) are updated in place; ``done[m]`` and ``status[m]`` get
+    each system's completed steps and failure code (-1 for success; ``integrators.common``)."""
+    systems = state.pos.shape[0]
+    chunks = min(systems, CHUNKS)
+    for c in prange(chunks):
         work = _workspace(state.n)
-        tm, hm, dm, bm = step_system(m, family, t[m], h[m], steps, state, model, work, vdep,
-                                     tol, drifts, kicks)
-        t[m] = tm
-        h[m] = hm
-        done[m] = dm
-        status[m] = bm
+        for m in range(c * systems // chunks, (c + 1) * systems // chunks):
+            tm, hm, dm, sm = step_system(m, family, t[m], h[m], steps, state, model, work, vdep,
+                                         tol, drifts, kicks)
+            t[m] = tm
+            h[m] = hm
+            done[m] = dm
+            status[m] = sm
+
+
+@njit(parallel=True, cache=True, error_model="numpy")
+def first_invalid(state, found):
+    """Bad input written into a batch's arrays, found before a step: ``found[m]`` is 0 when
+    system m is valid, else ``field * 2**32 + particle`` for its first invalid value (a
+    non-finite number, or a negative mass or radius; field 1 to 5 = pos, vel, mass, charge,
+    radius)."""
+    n = state.n
+    for m in prange(state.pos.shape[0]):
+        code = 0
+        for i in range(n):
+            if code:
+                break
+            for k in range(state.pos.shape[1]):
+                if not math.isfinite(state.pos[m, k, i]):
+                    code = 1 * 2 ** 32 + i
+                elif not math.isfinite(state.vel[m, k, i]):
+                    code = 2 * 2 ** 32 + i
+            if code:
+                break
+            if not (math.isfinite(state.mass[m, i]) and state.mass[m, i] >= 0.0):
+                code = 3 * 2 ** 32 + i
+            elif not math.isfinite(state.charge[m, i]):
+                code = 4 * 2 ** 32 + i
+            elif not (math.isfinite(state.radius[m, i]) and state.radius[m, i] >= 0.0):
+                code = 5 * 2 ** 32 + i
+        found[m] = code
 
 
 @njit(parallel=True, cache=True, error_model="numpy")
@@ -514,24 +551,24 @@ class Batch:
                 particle=code if code >= 0 else None)
 
     def _check_state(self, state):
+        """Refuse bad input written into the arrays (ValueError naming the field, system and
+        particle; nothing changed); set pinned particles' velocities back to zero."""
         n = self.n
         pin = self._pinned[:, :n]
         if pin.any():
             self._vel[:, :, :n][np.broadcast_to(pin[:, None, :], (self.systems, self.dim, n))] = 0.0
-        for field, arr, minimum in (("pos", self._pos[:, :, :n], None), ("vel", self._vel[:, :, :n], None),
-                                    ("mass", self._mass[:, :n], 0.0),
-                                    ("charge", self._charge[:, :n], None),
-                                    ("radius", self._radius[:, :n], 0.0)):
-            status = ~np.isfinite(arr)
-            if minimum is not None:
-                status |= arr < minimum
-            if status.any():
-                where = tuple(int(x) for x in np.argwhere(status)[0])
-                m, i = where[0], where[-1]
-                raise ValueError(f"{field} of system {m}, particle {i} must be finite"
-                                 f"{'' if minimum is None else ' and >= 0'}, got "
-                                 f"{float(arr[where])!r} (written directly: bad input); "
-                                 "nothing was changed")
+        found = np.zeros(self.systems, dtype=np.int64)
+        first_invalid(state, found)
+        bad_systems = np.flatnonzero(found)
+        if bad_systems.size:
+            m = int(bad_systems[0])
+            field = ("pos", "vel", "mass", "charge", "radius")[int(found[m] >> 32) - 1]
+            i = int(found[m] & 0xFFFFFFFF)
+            value = {"pos": self._pos[m, :, i], "vel": self._vel[m, :, i]}.get(field)
+            value = value.tolist() if value is not None else float(getattr(self, "_" + field)[m, i])
+            rule = " and >= 0" if field in ("mass", "radius") else ""
+            raise ValueError(f"{field} of system {m}, particle {i} must be finite{rule}, got "
+                             f"{value!r} (written directly: bad input); nothing was changed")
 
     # -- diagnostics -----------------------------------------------------------------
     def _moving(self):

@@ -13,7 +13,9 @@ of the ratios is reported (with the median times). Sections:
 4. the cost of the force terms declared (1, 2 and 4 terms on the same particles);
 5. start-up: ``import engine`` plus a first step, with a warm and with a cold numba cache;
 6. headless Spacewar: frames per second of one match with built-in bots, and of many
-   matches advanced together.
+   matches advanced together;
+7. ``engine.Batch``: 4096 systems of the game's size advanced by one call, against one
+   ``Simulation.step`` call per system, at 1 thread and at every thread.
 """
 import argparse
 import json
@@ -384,6 +386,71 @@ def bench_spacewar(matches=256, frames=2000):
     }
 
 
+# -- 7. Many systems per call: engine.Batch ----------------------------------------------------
+def _batch_scene(systems, slots, seed=1):
+    """The game's size and forces: 2 ships and slots - 2 test particles per system on the unit
+    torus, a star (PointMass), ship gravity (NBodyGravity) and thrust, symplectic Euler."""
+    rng = np.random.default_rng(seed)
+    return {"pos": rng.uniform(-0.5, 0.5, (systems, slots, 2)),
+            "vel": rng.normal(0.0, 1e-3, (systems, slots, 2)),
+            "test": np.arange(slots) >= 2,
+            "thrust": rng.normal(0.0, 1e-6, (systems, 2, 2))}
+
+
+def _batch_terms():
+    from engine import forces
+    return [forces.PointMass(mu=2.5e-7, softening=4e-3),
+            forces.NBodyGravity(G=1e-6, softening=1e-2), forces.Thrust()]
+
+
+def bench_batch(systems=4096, slots=66, repeats=5):
+    """Systems advanced per second: one ``Batch.step`` for all against one ``Simulation.step``
+    per system, at 1 and at every thread; one frame (one step) per call, as a game takes."""
+    import numba
+
+    from engine import Batch, Simulation
+
+    scene = _batch_scene(systems, slots)
+    batch = Batch(systems=systems, dim=2, integrator="symplectic_euler", dt=1.0, capacity=slots,
+                  box=1.0)
+    batch.add_many(mass=1.0, pos=scene["pos"], vel=scene["vel"], test=scene["test"])
+    terms = [batch.add_force(t) for t in _batch_terms()]
+    force = np.zeros((systems, slots, 2))
+    force[:, :2] = scene["thrust"]
+    batch.set_parameter(terms[-1], "force", force)
+    sims = []
+    for m in range(systems):
+        sim = Simulation(dim=2, integrator="symplectic_euler", dt=1.0, capacity=slots, box=1.0)
+        sim.add_many(mass=1.0, pos=scene["pos"][m], vel=scene["vel"][m], test=scene["test"])
+        thrust = [sim.add_force(t) for t in _batch_terms()][-1]
+        thrust.set(0, scene["thrust"][m, 0])
+        thrust.set(1, scene["thrust"][m, 1])
+        sims.append(sim)
+    batch.step(2)  # compiled code loaded; every system two steps in, alone as in the batch
+    for sim in sims:
+        sim.step(2)
+
+    def separate():
+        for sim in sims:
+            sim.step(1)
+
+    rows = {}
+    threads = numba.get_num_threads()
+    try:
+        for count in sorted({1, numba.config.NUMBA_NUM_THREADS}):
+            numba.set_num_threads(count)
+            t_batch, t_sims, ratio = side_by_side(lambda: batch.step(1), separate, repeats)
+            rows[str(count)] = {"batch_systems_per_second": systems / t_batch,
+                                "separate_simulations_per_second": systems / t_sims,
+                                "speedup": ratio}
+    finally:
+        numba.set_num_threads(threads)
+    # the same steps, the same numbers: the batch is bit-identical to the separate simulations
+    same = all(np.array_equal(batch.pos[m], sims[m].pos) for m in range(0, systems, 97))
+    return {"systems": systems, "slots": slots, "threads": rows,
+            "bit_identical_to_separate": bool(same)}
+
+
 # -- the machine --------------------------------------------------------------------------------
 def machine():
     import numba
@@ -416,7 +483,7 @@ def machine():
 
 
 def run(quick=False, sections=None):
-    sections = sections or ["direct", "small", "scaling", "terms", "startup", "spacewar"]
+    sections = sections or ["direct", "small", "scaling", "terms", "startup", "spacewar", "batch"]
     repeats = 3 if quick else 7
     report = {"machine": machine(), "quick": quick}
     if "direct" in sections:
@@ -431,6 +498,8 @@ def run(quick=False, sections=None):
         report["startup"] = bench_startup()
     if "spacewar" in sections:
         report["spacewar"] = bench_spacewar(64 if quick else 256, 500 if quick else 2000)
+    if "batch" in sections:
+        report["batch"] = bench_batch(1024 if quick else 4096, repeats=3 if quick else 5)
     return report
 
 
@@ -569,6 +638,14 @@ def format_report(r):
                      f"{s['one_match_no_bots_frames_per_second']:.0f} frames/s; "
                      f"{s['batch']['matches']} matches together "
                      f"{s['batch']['match_frames_per_second']:.3e} match-frames/s")
+    if "batch" in r:
+        b = r["batch"]
+        lines.append(f"\n7. engine.Batch: {b['systems']} systems of {b['slots']} slots, one step per call "
+                     f"(bit-identical to separate simulations: {b['bit_identical_to_separate']})")
+        for count, row in b["threads"].items():
+            lines.append(f"  {count} thread(s): batch {row['batch_systems_per_second']:.3e} "
+                         f"system-steps/s; separate Simulation.step calls "
+                         f"{row['separate_simulations_per_second']:.3e}; {row['speedup']:.1f}x")
     if targets(r):
         lines.append("\ntargets:")
         for name, measured, met in targets(r):
@@ -655,6 +732,20 @@ def format_markdown(r, command):
                 "frames per second",
                 f"- {s['batch']['matches']} matches advanced together by one compiled call: "
                 f"{s['batch']['match_frames_per_second']:.3e} match-frames per second", ""]
+    if "batch" in r:
+        b = r["batch"]
+        out += [f"## 7. Many systems per call (`engine.Batch`, {b['systems']} systems of "
+                f"{b['slots']} slots)", "",
+                "The game's size and forces (2 ships and 64 test particles per system on the unit "
+                "torus: star, ship gravity, thrust; symplectic Euler), one step per call as a game "
+                "frame takes. Against a `Simulation.step` call per system; the results are "
+                f"bit-identical ({b['bit_identical_to_separate']}).", "",
+                "| threads | batch system-steps/s | separate `Simulation.step` calls/s | speed-up |",
+                "|---|---|---|---|"]
+        out += [f"| {count} | {row['batch_systems_per_second']:.3e} | "
+                f"{row['separate_simulations_per_second']:.3e} | {row['speedup']:.1f}x |"
+                for count, row in b["threads"].items()]
+        out.append("")
     return "\n".join(out)
 
 
@@ -665,7 +756,7 @@ def main(argv=None):
     parser.add_argument("--json", metavar="FILE", help="also write the results as JSON")
     parser.add_argument("--markdown", metavar="FILE", help="also write the results as Markdown")
     parser.add_argument("--only", metavar="SECTIONS",
-                        help="comma-separated: direct,small,scaling,terms,startup,spacewar")
+                        help="comma-separated: direct,small,scaling,terms,startup,spacewar,batch")
     args = parser.parse_args(argv)
     # a bad output path fails now, not after minutes of benchmarks
     try:
