@@ -129,6 +129,17 @@ def index_array(name, value, width=None):
     return np.array(raw, dtype=np.int64)
 
 
+def int_in_range(name, value, minimum, maximum):
+    """An int in ``[minimum, maximum]``: bools, floats, text and None are a TypeError, an int
+    out of range a ValueError (a count of systems, a capacity)."""
+    if isinstance(value, _BOOLS) or not isinstance(value, numbers.Integral):
+        raise TypeError(f"{name} must be an int in [{minimum}, {maximum}], got {value!r} "
+                        f"({type(value).__name__})")
+    if not minimum <= value <= maximum:
+        raise ValueError(f"{name} must be an int in [{minimum}, {maximum}], got {value!r}")
+    return int(value)
+
+
 def step_count(name, value, minimum=0):
     """An int step count in ``[minimum, MAX_STEPS]``.
 

@@ -36,7 +36,8 @@ from numba import njit, prange
 
 from . import diagnostics
 from . import integrators as _integrators
-from ._validate import finite_float, nonnegative_float, positive_float, real_array, step_count
+from ._validate import (finite_float, int_in_range, nonnegative_float, positive_float, real_array,
+                        step_count)
 from .errors import SimulationError
 from .forces.base import Force
 from .forces.dispatch import pack, potential_terms
@@ -178,14 +179,10 @@ class Batch:
 
     def __init__(self, systems, dim=2, integrator="symplectic_euler", dt=1.0, tolerance=1e-9,
                  G=None, capacity=16, box=None):
-        if isinstance(systems, (bool, np.bool_)) or not isinstance(systems, numbers.Integral) \
-                or not 1 <= systems <= MAX_SYSTEMS:
-            raise ValueError(f"systems must be an int in [1, {MAX_SYSTEMS}], got {systems!r}")
+        systems = int_in_range("systems", systems, 1, MAX_SYSTEMS)
         if isinstance(dim, bool) or dim not in (2, 3):
             raise ValueError(f"dim must be 2 or 3, got {dim!r}")
-        if isinstance(capacity, (bool, np.bool_)) or not isinstance(capacity, numbers.Integral) \
-                or not 0 <= capacity <= 2 ** 31:
-            raise ValueError(f"capacity must be an int in [0, {2 ** 31}], got {capacity!r}")
+        capacity = int_in_range("capacity", capacity, 0, 2 ** 31)
         self._integrator = _integrators.check_name(integrator)
         dt = finite_float("dt", dt)
         if dt == 0.0:

@@ -135,6 +135,11 @@ class Simulation:
     def t(self, value):
         self._t = finite_float("t", self._code(value, "time", "t"))
 
+    @property
+    def time(self):
+        """The time as an astropy Quantity in the simulation's units (the float ``t`` without)."""
+        return self._t if self._units is None else self._units.to_quantity(self._t, "time")
+
     # -- particles -------------------------------------------------------------------
     @property
     def n(self):

@@ -72,3 +72,16 @@ def test_quantity_without_units_is_refused():
 def test_bad_units(units, match):
     with pytest.raises(ValueError, match=match):
         Simulation(units=units)
+
+
+def test_time_is_a_quantity_in_the_simulations_units():
+    import astropy.units as u
+
+    from engine import Simulation
+    sim = Simulation(dim=3, units=("AU", "yr", "Msun"), dt=0.25 * u.yr)
+    sim.add(mass=1.0 * u.Msun)
+    sim.step(3)
+    assert sim.time.unit == u.yr and sim.time.value == 0.75
+    plain = Simulation(dt=0.5)
+    plain.step(2)
+    assert plain.time == 1.0 and isinstance(plain.time, float)
