@@ -343,19 +343,19 @@ def scene(snapshot, size, effects=None, names=None, rounds=None, footer=(), bann
         for event in effects.current(frame):
             prims.extend(_flash(event, frame, size))
     # the score line
-    fp = font_pixels(size)
+    text_px = font_pixels(size)
     names = DEFAULT_NAMES if names is None else names
     s0, s1 = snapshot["scores"]
-    margin = fp * 0.5
-    prims.append(("text", margin, margin * 0.6, f"{names[0]}  {s0}", SHIP_COLOURS[0], "left", fp))
-    prims.append(("text", size - margin, margin * 0.6, f"{s1}  {names[1]}", SHIP_COLOURS[1], "right", fp))
-    prims.append(("text", size / 2.0, margin * 0.6, _round_label(snapshot, rounds), TEXT, "centre", fp))
-    small = max(9, int(fp * 0.8))
+    margin = text_px * 0.5
+    prims.append(("text", margin, margin * 0.6, f"{names[0]}  {s0}", SHIP_COLOURS[0], "left", text_px))
+    prims.append(("text", size - margin, margin * 0.6, f"{s1}  {names[1]}", SHIP_COLOURS[1], "right", text_px))
+    prims.append(("text", size / 2.0, margin * 0.6, _round_label(snapshot, rounds), TEXT, "centre", text_px))
+    small = max(9, int(text_px * 0.8))
     for k, (text, rgb) in enumerate(reversed(list(footer))):
         prims.append(("text", size / 2.0, size - (k + 1) * small * 1.35 - margin * 0.3, text, rgb,
                       "centre", small))
     if banner:
-        big = 2 * fp
+        big = 2 * text_px
         prims.append(("text", size / 2.0, size * 0.3, banner, TEXT, "centre", big))
     return prims
 
@@ -484,12 +484,12 @@ class _GifWriter:
     A frame identical to the one before only lengthens that one's display time.
     """
 
-    def __init__(self, fp, fps):
+    def __init__(self, stream, fps):
         from PIL import GifImagePlugin
 
         self._gif = GifImagePlugin
         self.streaming = hasattr(GifImagePlugin, "getheader") and hasattr(GifImagePlugin, "getdata")
-        self.fp = fp
+        self.stream = stream
         self.fps = fps
         self.added = 0  # frames given to add()
         self.written = 0  # GIF frames in the file
@@ -516,10 +516,10 @@ class _GifWriter:
             self._pending = None
         if self.streaming:
             if self.written:
-                self.fp.write(b";")
+                self.stream.write(b";")
         elif self._kept:
             images = [im for im, _ in self._kept]
-            images[0].save(self.fp, format="GIF", save_all=True, append_images=images[1:],
+            images[0].save(self.stream, format="GIF", save_all=True, append_images=images[1:],
                            duration=[10 * cs for _, cs in self._kept], loop=0, optimize=True)
             self.written = len(images)
 
@@ -544,7 +544,7 @@ class _GifWriter:
             chunks = self._gif.getdata(delta, (int(x0), int(y0)), duration=10 * cs, disposal=1,
                                        transparency=TRANSPARENT)
         for chunk in chunks:
-            self.fp.write(chunk)
+            self.stream.write(chunk)
         self._last = pixels
         self.written += 1
 
