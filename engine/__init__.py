@@ -12,6 +12,7 @@ from .cache import project_cache
 
 with project_cache("engine"):
     from . import analytic, atomic, cache, clock, diagnostics, forces, integrators, space, state
+    from . import stability
     from .batch import Batch
     from .atomic import OutputPathError, atomic_write, check_output_dir, check_output_path
     from .clock import FixedStepClock
@@ -22,5 +23,5 @@ with project_cache("engine"):
 __version__ = "0.1.0"
 
 __all__ = ["Simulation", "Batch", "space", "state", "SimulationError", "INTEGRATORS", "ORDERS", "SYMPLECTIC", "forces", "integrators",
-           "analytic", "clock", "diagnostics", "FixedStepClock", "__version__", "atomic",
+           "analytic", "clock", "diagnostics", "stability", "FixedStepClock", "__version__", "atomic",
            "atomic_write", "check_output_path", "check_output_dir", "OutputPathError"]

@@ -3,6 +3,9 @@
 Integrates the Kepler problem (e = 0.6, Hairer, Lubich & Wanner's test) for 100 orbits with
 every integrator at the same cost in force evaluations, and prints each one's energy error
 and its position error against the closed-form solution (``engine.analytic.kepler``).
+
+``python -m engine cloth [--out cloth.gif] [--frames N] ...``: a pinned cloth in the wind and a
+rope beside it, drawn to a GIF (``engine.cloth_demo``; needs the ``[viz]`` extra).
 """
 import argparse
 import math
@@ -10,7 +13,7 @@ import time
 
 import numpy as np
 
-from . import INTEGRATORS, Simulation, analytic, forces
+from . import INTEGRATORS, Simulation, analytic, cloth_demo, forces
 from .integrators import FORCE_EVALUATIONS, ORDERS
 
 
@@ -42,7 +45,16 @@ def main(argv=None):
     parser.add_argument("--orbits", type=int, default=100)
     parser.add_argument("--evaluations", type=int, default=400,
                         help="force evaluations per orbit for the fixed-step methods")
+    commands = parser.add_subparsers(dest="command", metavar="{cloth}",
+                                     help="cloth: the cloth-and-rope GIF demo (without a "
+                                          "command: the Kepler tour)")
+    cloth = commands.add_parser("cloth", help="a pinned cloth in the wind and a rope, to a GIF",
+                                description=cloth_demo.__doc__.split("\n\n")[0])
+    cloth_demo.add_arguments(cloth)
     args = parser.parse_args(argv)
+    if args.command == "cloth":
+        cloth_demo.main(args, cloth)
+        return
     print(f"Kepler problem, e = 0.6, {args.orbits} orbits, "
           f"{args.evaluations} force evaluations per orbit (rk45: tolerance 1e-10)")
     print(f"{'integrator':<17}{'order':>5}{'steps':>10}{'|dE/E|':>11}{'|r - r_exact|':>15}{'time':>10}")
