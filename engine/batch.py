@@ -24,7 +24,7 @@ sets that parameter for every system; ``set_parameter`` sets it per system, and 
 that parameter is per system (a later attribute change leaves it alone).
 
 Compiled code of your own (a game's frame) takes ``batch.kernel_arguments()``: an
-``engine.state.State`` whose arrays carry the system axis, and a ``Model`` whose ``fp`` is
+``engine.state.State`` whose arrays carry the system axis, and a ``Model`` whose ``params`` is
 ``(M, F)``; ``system_state(state, m)`` and ``system_model(model, m)`` give one system's
 named tuples, and ``advance_system`` steps it with a splitting scheme.
 """
@@ -63,7 +63,7 @@ def system_state(state, m):
 @njit(cache=True, inline="always")
 def system_model(model, m):
     """System m's force terms: the shared tables with its own row of float parameters."""
-    return Model(model.kinds, model.fp[m], model.foff, model.ip, model.ioff)
+    return Model(model.kinds, model.params[m], model.param_offsets, model.indices, model.index_offsets)
 
 
 @njit(cache=True, error_model="numpy")
@@ -137,8 +137,13 @@ def first_invalid(state, found):
             for k in range(state.pos.shape[1]):
                 if not math.isfinite(state.pos[m, k, i]):
                     code = 1 * 2 ** 32 + i
-                elif not math.isfinite(state.vel[m, k, i]):
+                    break
+            if code:
+                break
+            for k in range(state.pos.shape[1]):
+                if not math.isfinite(state.vel[m, k, i]):
                     code = 2 * 2 ** 32 + i
+                    break
             if code:
                 break
             if not (math.isfinite(state.mass[m, i]) and state.mass[m, i] >= 0.0):
@@ -158,7 +163,10 @@ def energies(t, state, model, moving, terms, kinetic, potential):
         out = np.zeros(terms)
         potential_terms(t[m], s, system_model(model, m), out)
         kinetic[m] = diagnostics.kinetic_energy(s.vel, s.mass, moving[m], s.n)
-        potential[m] = out.sum()
+        total = 0.0
+        for u in out:  # in declaration order, as Simulation.potential_energy adds them
+            total += u
+        potential[m] = total
 
 
 @njit(parallel=True, cache=True, error_model="numpy")
@@ -427,7 +435,7 @@ class Batch:
                     raise ValueError(f"{type(term).__name__} has no parameter {name!r}; its "
                                      f"parameters are {', '.join(layout)}")
                 start, shape = layout[name]
-                start += int(self._model.foff[k])
+                start += int(self._model.param_offsets[k])
                 size = int(np.prod(shape, dtype=np.int64))
                 return slice(start, start + size), shape
         raise ValueError(f"{term!r} is not declared in this batch")
@@ -436,7 +444,7 @@ class Batch:
         """The packed values of ``term``'s parameter ``name`` in every system, (M, *shape)
         (a copy; names are the term's ``LAYOUT``, e.g. ``"pos"`` of a PointMass)."""
         cols, shape = self._slot(term, name)
-        return self._model.fp[:, cols].reshape((self.systems,) + shape).copy()
+        return self._model.params[:, cols].reshape((self.systems,) + shape).copy()
 
     def set_parameter(self, term, name, values):
         """Set ``term``'s parameter ``name`` per system: ``values`` of shape (M, *shape), or
@@ -450,13 +458,21 @@ class Batch:
         except ValueError:
             raise ValueError(f"{name} must have shape (systems={self.systems}, *{shape}) or "
                              f"{shape}, got shape {arr.shape}") from None
-        if not np.all(np.isfinite(arr)):
-            raise ValueError(f"{name} must be finite, got {float(arr[~np.isfinite(arr)][0])!r}")
-        self._model.fp[:, cols] = arr.reshape(self.systems, -1)
+        flat = arr.reshape(self.systems, -1)
+        invalid = ~np.isfinite(flat)
+        minimum, strict = type(term).BOUNDS.get(name, (None, False))
+        if minimum is not None:
+            invalid |= (flat <= minimum) if strict else (flat < minimum)
+        if invalid.any():
+            m, j = (int(x) for x in np.argwhere(invalid)[0])
+            rule = "finite" if minimum is None else f"finite and {'>' if strict else '>='} {minimum}"
+            raise ValueError(f"{type(term).__name__}.{name} must be {rule}, got "
+                             f"{float(flat[m, j])!r} (system {m}); nothing was changed")
+        self._model.params[:, cols] = flat
         self._mark_per_system(term, name)
 
     def parameter_columns(self, term, name):
-        """``(start, stop)``: the columns of ``name`` in ``kernel_arguments()[1].fp`` rows, for
+        """``(start, stop)``: the columns of ``name`` in ``kernel_arguments()[1].params`` rows, for
         compiled code that writes the parameter itself every step (a ship's thrust); the
         parameter becomes per system, as with ``set_parameter``."""
         cols, _ = self._slot(term, name)
@@ -473,23 +489,30 @@ class Batch:
             return self._model
         model = pack(self._forces, self)
         layouts = [term.layout(self) for term in self._forces]
-        for term, layout, f0, f1 in zip(self._forces, layouts, model.foff[:-1], model.foff[1:]):
+        for term, layout, f0, f1 in zip(self._forces, layouts, model.param_offsets[:-1], model.param_offsets[1:]):
             declared = sum(int(np.prod(shape, dtype=np.int64)) for _, shape in layout.values())
             if declared != f1 - f0:
                 raise RuntimeError(f"{type(term).__name__}.LAYOUT declares {declared} floats but "
                                    f"the term packs {f1 - f0}: the declaration is wrong")
-        rows = np.repeat(model.fp[None, :], self.systems, axis=0)
+        rows = np.repeat(model.params[None, :], self.systems, axis=0)
         for term, name in self._per_system:  # per-system values survive a re-pack
             k = next(i for i, f in enumerate(self._forces) if f is term)
             start, shape = layouts[k][name]
             size = int(np.prod(shape, dtype=np.int64))
             old_start, old_shape = self._old_slot(term, name)
-            if old_shape != shape:
+            new0 = int(model.param_offsets[k]) + start
+            old = self._model.params[:, old_start:old_start + int(np.prod(old_shape, dtype=np.int64))]
+            if old_shape == shape:
+                rows[:, new0:new0 + size] = old
+            elif old_shape[1:] == shape[1:]:
+                # one row per slot (a Thrust's force) and slots were added: the rows kept, the
+                # new slots' rows as the term packs them
+                kept = min(old_shape[0], shape[0]) * int(np.prod(shape[1:], dtype=np.int64))
+                rows[:, new0:new0 + kept] = old[:, :kept]
+            else:  # pragma: no cover - no declared layout changes any other way
                 raise ValueError(f"{type(term).__name__}.{name} was set per system with shape "
-                                 f"{old_shape}, and it now has shape {shape}; set it again")
-            new0 = int(model.foff[k]) + start
-            rows[:, new0:new0 + size] = self._model.fp[:, old_start:old_start + size]
-        self._model = Model(model.kinds, rows, model.foff, model.ip, model.ioff)
+                                 f"{old_shape}, and it now has shape {shape}")
+        self._model = Model(model.kinds, rows, model.param_offsets, model.indices, model.index_offsets)
         self._layouts = {k: layout for k, layout in enumerate(layouts)}
         self._layout_terms = list(self._forces)
         self._model_key = key
@@ -500,12 +523,12 @@ class Batch:
         for k, f in enumerate(self._layout_terms):
             if f is term:
                 start, shape = self._layouts[k][name]
-                return int(self._model.foff[k]) + start, shape
+                return int(self._model.param_offsets[k]) + start, shape
         raise ValueError(f"{term!r} was not packed before")
 
     def kernel_arguments(self):
         """``(state, model)`` with the system axis: ``State`` arrays of shape (M, dim, capacity)
-        and (M, capacity), ``Model.fp`` of shape (M, F); for compiled code of your own."""
+        and (M, capacity), ``Model.params`` of shape (M, F); for compiled code of your own."""
         state = State(self._pos, self._vel, self._mass, self._charge, self._radius, self._active,
                       self._test, self._pinned, self.n, self._box)
         return state, self._current_model()
@@ -532,6 +555,9 @@ class Batch:
                     kicks, done, status)
         if family != RK45:
             self._h[:] = h_before
+        else:  # as a Simulation does: a failed system keeps the step it had
+            keep = (status >= 0) | (status == TIME_OVERFLOW)
+            self._h[keep] = h_before[keep]
         self._steps += done
         failed = np.flatnonzero(status != -1)
         if failed.size:

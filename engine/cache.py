@@ -95,3 +95,26 @@ def project_cache(package="engine"):
         yield
     finally:
         config.CACHE_DIR = previous
+
+
+def compiler(package, **defaults):
+    """A decorator factory like ``numba.njit(cache=True, ...)`` whose compiled code lives in
+    ``package``'s directory whatever imported the module first (numba fixes a function's
+    cache location when it is decorated, so a module imported outside ``project_cache`` would
+    otherwise cache beside its source, keyed on that file alone)::
+
+        jit = compiler("spacewar")
+
+        @jit()
+        def step_match(...): ...
+    """
+    _check_package(package)
+
+    def jit(**options):
+        def decorate(function):
+            import numba
+
+            with project_cache(package):
+                return numba.njit(cache=True, **{**defaults, **options})(function)
+        return decorate
+    return jit

@@ -327,9 +327,9 @@ class Simulation:
                     raise ValueError(f"{type(term).__name__} has no parameter {name!r}; its "
                                      f"parameters are {', '.join(layout)}")
                 start, shape = layout[name]
-                start += int(model.foff[k])
+                start += int(model.param_offsets[k])
                 size = int(np.prod(shape, dtype=np.int64))
-                return model.fp[start:start + size].reshape(shape).copy()
+                return model.params[start:start + size].reshape(shape).copy()
         raise ValueError(f"{term!r} is not declared in this simulation")
 
     def kernel_arguments(self):
@@ -467,8 +467,12 @@ class Simulation:
         return out
 
     def potential_energy(self):
-        """Sum of the potentials of the declared conservative terms."""
-        return float(self.potential_energy_terms().sum())
+        """Sum of the potentials of the declared conservative terms, added in declaration
+        order (as ``Batch.potential_energy`` adds them, so the two agree to the bit)."""
+        total = 0.0
+        for u in self.potential_energy_terms().tolist():
+            total += u
+        return total
 
     def energy(self):
         return self.kinetic_energy() + self.potential_energy()

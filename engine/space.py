@@ -16,7 +16,7 @@ float precision) or ``wrap_scalar`` (float64), the same formula.
 import numpy as np
 from numba import njit
 
-from ._validate import optional, positive_float
+from ._validate import nonnegative_float, optional
 
 
 def wrap(x, side):
@@ -52,8 +52,9 @@ def wrap_scalar(x, side):
 
 
 def check_box(box):
-    """The side of a periodic space as a float (``None`` or 0 means open space: 0.0)."""
-    value = optional(positive_float)("box", box)
+    """The side of a periodic space as a float: ``None`` or 0 means open space (0.0), so
+    ``Simulation(box=sim.box)`` copies any simulation's space."""
+    value = optional(nonnegative_float)("box", box)
     return 0.0 if value is None else value
 
 

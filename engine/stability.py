@@ -87,6 +87,7 @@ from .forces import springs as _springs
 from .integrators import INTEGRATORS, check_name
 from .integrators.dormand_prince import _A as _DP_A
 from .integrators.splitting import SCHEMES
+from .space import wrap_scalar
 
 #: relative stopping tolerance of the power iteration on omega_max^2
 TOLERANCE = 1e-4
@@ -186,7 +187,8 @@ def step_limits():
 # -- the spring network ------------------------------------------------------------------------
 
 @njit(cache=True, error_model="numpy")
-def _spring_blocks(pos, active, fp, f0, ip, i0, i1, out_a, out_b, out_h, start):
+def _spring_blocks(pos, active, box, params, f0, indices, i0, i1, out_a, out_b, out_h,
+                   start):
     """The Hessian blocks H of one Springs term's springs with both ends active, written from
     row ``start`` of the outputs; returns the next free row, or -(s + 1) for a spring s with
     l > 0 whose ends coincide (no direction: the step itself would fail)."""
@@ -194,15 +196,15 @@ def _spring_blocks(pos, active, fp, f0, ip, i0, i1, out_a, out_b, out_h, start):
     m = (i1 - i0) // 2
     row = start
     for s in range(m):
-        a = ip[i0 + 2 * s]
-        b = ip[i0 + 2 * s + 1]
+        a = indices[i0 + 2 * s]
+        b = indices[i0 + 2 * s + 1]
         if not (active[a] and active[b]):
             continue
-        k = fp[f0 + s]
-        rest = fp[f0 + m + s]
+        k = params[f0 + s]
+        rest = params[f0 + m + s]
         r2 = 0.0
         for c in range(dim):
-            d = pos[c, b] - pos[c, a]
+            d = wrap_scalar(pos[c, b] - pos[c, a], box)  # the nearest image, as the force
             r2 += d * d
         r = math.sqrt(r2)
         if rest == 0.0:
@@ -214,9 +216,9 @@ def _spring_blocks(pos, active, fp, f0, ip, i0, i1, out_a, out_b, out_h, start):
             axial = k
             across = k * (1.0 - rest / r)
         for p in range(dim):
-            up = (pos[p, b] - pos[p, a]) / r if r > 0.0 else 0.0
+            up = wrap_scalar(pos[p, b] - pos[p, a], box) / r if r > 0.0 else 0.0
             for q in range(dim):
-                uq = (pos[q, b] - pos[q, a]) / r if r > 0.0 else 0.0
+                uq = wrap_scalar(pos[q, b] - pos[q, a], box) / r if r > 0.0 else 0.0
                 uu = up * uq
                 out_h[row, p, q] = axial * uu + across * ((1.0 if p == q else 0.0) - uu)
         out_a[row] = a
@@ -289,7 +291,7 @@ def _moving(state):
 
 def _spring_network(state, model):
     """All spring Hessian blocks ``(a, b, H)`` of the declared Springs terms."""
-    counts = [(model.ioff[s + 1] - model.ioff[s]) // 2
+    counts = [(model.index_offsets[s + 1] - model.index_offsets[s]) // 2
               for s in range(len(model.kinds)) if model.kinds[s] == _springs.KIND]
     total = int(sum(counts))
     dim = state.pos.shape[0]
@@ -301,8 +303,9 @@ def _spring_network(state, model):
     for s in range(len(model.kinds)):
         if model.kinds[s] != _springs.KIND:
             continue
-        got = _spring_blocks(state.pos, state.active, model.fp, model.foff[s], model.ip,
-                             model.ioff[s], model.ioff[s + 1], pa, pb, h, row)
+        got = _spring_blocks(state.pos, state.active, state.box, model.params,
+                             model.param_offsets[s], model.indices, model.index_offsets[s],
+                             model.index_offsets[s + 1], pa, pb, h, row)
         if got < 0:
             raise ValueError(f"spring {-got - 1} of Springs term {term} has coincident ends and "
                              "a rest length > 0: it has no direction (a step would fail too)")
@@ -433,26 +436,25 @@ def _gravity_rate(pos, mass, active, test, moving, n, G, eps2, box):
             r2 = 0.0
             for c in range(dim):
                 d = pos[c, j] - pos[c, i]
-                if box > 0.0:
-                    d -= box * math.floor(d / box + 0.5)
+                d = wrap_scalar(d, box)  # the nearest image (unchanged in open space)
                 r2 += d * d
             top = max(top, _pair_rate(C, r2, eps2))
     return top
 
 
 @njit(cache=True, error_model="numpy")
-def _point_mass_rate(pos, moving, n, fp, f0, ip, i0, i1):
+def _point_mass_rate(pos, moving, n, params, f0, indices, i0, i1):
     dim = pos.shape[0]
-    mu = fp[f0]
-    eps2 = fp[f0 + 1]
+    mu = params[f0]
+    eps2 = params[f0 + 1]
     top = 0.0
     for k in range(n if i1 == i0 else i1 - i0):
-        i = k if i1 == i0 else ip[i0 + k]
+        i = k if i1 == i0 else indices[i0 + k]
         if i >= n or not moving[i]:
             continue
         r2 = 0.0
         for c in range(dim):
-            d = pos[c, i] - fp[f0 + 2 + c]
+            d = pos[c, i] - params[f0 + 2 + c]
             r2 += d * d
         top = max(top, _pair_rate(mu, r2, eps2))
     return top
@@ -466,15 +468,15 @@ def gravity_frequency(sim):
     moving = _moving(state)
     top = 0.0
     for s in range(len(model.kinds)):
-        f0 = model.foff[s]
+        f0 = model.param_offsets[s]
         if model.kinds[s] == _gravity.KIND:
-            G, eps2, own_box = model.fp[f0], model.fp[f0 + 1], model.fp[f0 + 2]
+            G, eps2, own_box = model.params[f0], model.params[f0 + 1], model.params[f0 + 2]
             box = own_box if own_box > 0.0 else state.box
             top = max(top, _gravity_rate(state.pos, state.mass, state.active, state.test,
                                          moving, n, G, eps2, box))
         elif model.kinds[s] == _point_mass.KIND:
-            top = max(top, _point_mass_rate(state.pos, moving, n, model.fp, f0, model.ip,
-                                            model.ioff[s], model.ioff[s + 1]))
+            top = max(top, _point_mass_rate(state.pos, moving, n, model.params, f0, model.indices,
+                                            model.index_offsets[s], model.index_offsets[s + 1]))
     return math.sqrt(top)
 
 

@@ -9,15 +9,15 @@ structs (fields read without reference counting in the ``_nrt=False`` kernels):
     all x, then all y), the per-particle arrays of shape ``(capacity,)``, the ``n`` slots in
     use, and the side of the periodic space (``0.0`` for open space; see ``engine.space``).
     ``active``, ``test`` and ``pinned`` are booleans.
-``Model(kinds, fp, foff, ip, ioff)``
+``Model(kinds, params, param_offsets, indices, index_offsets)``
     the packed force terms: term ``s`` has kind ``kinds[s]`` and parameters
-    ``fp[foff[s]:foff[s+1]]`` (float64) and ``ip[ioff[s]:ioff[s+1]]`` (int64); the names of
+    ``params[param_offsets[s]:param_offsets[s+1]]`` (float64) and ``indices[index_offsets[s]:index_offsets[s+1]]`` (int64); the names of
     the float parameters are given by each term's ``layout`` (``engine.forces.base``).
 ``Workspace(floats, ints, threads)``
     scratch for the large-N pair kernels (``pairwise.workspace``) and whether they may start
     a parallel region of their own (False inside a batch, whose systems already fill the cores).
 
-With these, a force kernel is ``accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work)`` and
+With these, a force kernel is ``accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work)`` and
 an integrator step is ``advance(t, h, steps, state, model, work, vdep, t_end, ...)``.
 """
 from collections import namedtuple
@@ -26,7 +26,7 @@ import numpy as np
 from numba import njit
 
 State = namedtuple("State", "pos vel mass charge radius active test pinned n box")
-Model = namedtuple("Model", "kinds fp foff ip ioff")
+Model = namedtuple("Model", "kinds params param_offsets indices index_offsets")
 Workspace = namedtuple("Workspace", "floats ints threads")
 
 EMPTY_WORKSPACE = Workspace(np.empty(0), np.empty(0, dtype=np.int64), False)
@@ -40,9 +40,9 @@ def with_motion(state, pos, vel):
 
 
 @njit(cache=True, inline="always")
-def with_parameters(model, fp):
+def with_parameters(model, params):
     """The same terms with another float parameter row (one system of a batch)."""
-    return Model(model.kinds, fp, model.foff, model.ip, model.ioff)
+    return Model(model.kinds, params, model.param_offsets, model.indices, model.index_offsets)
 
 
 __all__ = ["State", "Model", "Workspace", "EMPTY_WORKSPACE", "with_motion", "with_parameters"]

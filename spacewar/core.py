@@ -16,10 +16,10 @@ stream, so a match is bit-identical for a given seed whatever else runs beside i
 import math
 
 import numpy as np
-from numba import njit
 
 from engine import space
 from engine.batch import advance_system
+from engine.cache import compiler
 from engine.integrators import splitting
 from engine.state import Workspace
 
@@ -43,12 +43,15 @@ HEADING, OMEGA, FUEL, SF = 0, 1, 2, 3
 # action codes: turn index (0, 1, 2 for -1, 0, +1) + 3 thrust + 6 fire + 12 hyperspace + 24 flip
 from .codes import N_ACTIONS, NOOP  # noqa: E402  (kept here: core.NOOP is used throughout)
 
+#: numba's njit with this module's compiled code in the game's cache directory
+jit = compiler("spacewar")
+
 _GOLDEN = np.uint64(0x9E3779B97F4A7C15)
 _MIX1 = np.uint64(0xBF58476D1CE4E5B9)
 _MIX2 = np.uint64(0x94D049BB133111EB)
 
 
-@njit(cache=True)
+@jit()
 def next_u64(rng, m):
     """splitmix64 (Steele, Lea & Flood 2014): the next 64 random bits of match m's stream."""
     z = rng[m] + _GOLDEN
@@ -58,19 +61,19 @@ def next_u64(rng, m):
     return z ^ (z >> np.uint64(31))
 
 
-@njit(cache=True)
+@jit()
 def uniform(rng, m):
     """A float in [0, 1) with 53 random bits."""
     return float(next_u64(rng, m) >> np.uint64(11)) * (1.0 / 9007199254740992.0)
 
 
-@njit(cache=True, inline="always")
+@jit(inline="always")
 def wrap(x):
     """Onto the torus coordinate range [-0.5, 0.5): the engine's one wrap, side 1."""
     return space.wrap_scalar(x, 1.0)
 
 
-@njit(cache=True)
+@jit()
 def ship_start(s, rules):
     """Start position and heading: opposite corners of the star, each facing the other's side."""
     d = rules[R_START] / math.sqrt(2.0)
@@ -79,7 +82,7 @@ def ship_start(s, rules):
     return d, -d, 0.5 * math.pi
 
 
-@njit(cache=True)
+@jit()
 def reset_round(m, pos, vel, mass, charge, active, ship_gauges, ship_counters, torp_life, match_state, rules):
     """Ships back to their start, full stores, torpedoes cleared."""
     ntorp = int(rules[R_NTORP])
@@ -116,7 +119,7 @@ def reset_round(m, pos, vel, mass, charge, active, ship_gauges, ship_counters, t
     match_state[m, END_TIMER] = -1
 
 
-@njit(cache=True)
+@jit()
 def _kill_ship(m, s, active, ship_counters, frame):
     if ship_counters[m, s, ALIVE] == 1:
         ship_counters[m, s, ALIVE] = 0
@@ -125,7 +128,7 @@ def _kill_ship(m, s, active, ship_counters, frame):
         active[m, s] = False
 
 
-@njit(cache=True)
+@jit()
 def _fire(m, s, pos, vel, mass, charge, active, ship_gauges, ship_counters, torp_life, rules):
     ntorp = int(rules[R_NTORP])
     k = ntorp - ship_counters[m, s, TORPS]  # each torpedo of a round has its own slot
@@ -145,7 +148,7 @@ def _fire(m, s, pos, vel, mass, charge, active, ship_gauges, ship_counters, torp
     ship_counters[m, s, RELOAD] = int(rules[R_RELOAD])
 
 
-@njit(cache=True)
+@jit()
 def _reenter(m, s, pos, vel, active, ship_gauges, ship_counters, rng, rules):
     """Back from hyperspace at a random place, speed and heading; jump k breaks up with k/8."""
     ship_counters[m, s, IN_HYPER] = 0
@@ -168,7 +171,7 @@ def _reenter(m, s, pos, vel, active, ship_gauges, ship_counters, rng, rules):
     return uniform(rng, m) < breakup
 
 
-@njit(cache=True)
+@jit()
 def _control(m, s, code, frame, pos, vel, mass, charge, active, ship_gauges, ship_counters, torp_life, force_params,
              rng, rules):
     """Apply one ship's action for this frame: turn, thrust, fire, hyperspace, polarity."""
@@ -235,7 +238,7 @@ def _control(m, s, code, frame, pos, vel, mass, charge, active, ship_gauges, shi
     ship_counters[m, s, FIRE_LATCH] = 1 if fire else 0
 
 
-@njit(cache=True)
+@jit()
 def _hit(pos, m, a, b, box, diamond):
     """The original's diamond proximity test, by the nearest image on the torus."""
     dx = abs(space.wrap_scalar(pos[m, 0, b] - pos[m, 0, a], 1.0))  # the nearest image
@@ -243,7 +246,7 @@ def _hit(pos, m, a, b, box, diamond):
     return dx < box and dy < box and dx + dy < diamond
 
 
-@njit(cache=True)
+@jit()
 def _collisions(m, pos, vel, active, ship_counters, torp_life, match_state, rules):
     n = pos.shape[2]
     box = rules[R_HITBOX]
@@ -279,7 +282,7 @@ def _collisions(m, pos, vel, active, ship_counters, torp_life, match_state, rule
                 torp_life[m, b - 2] = 0
 
 
-@njit(cache=True)
+@jit()
 def _round_logic(m, pos, vel, mass, charge, active, ship_gauges, ship_counters, torp_life, match_state, rules):
     """End of round (a ship lost, both out of torpedoes, or the time limit), then scoring."""
     match_state[m, ROUND_FRAME] += 1
@@ -309,7 +312,7 @@ def _round_logic(m, pos, vel, mass, charge, active, ship_gauges, ship_counters, 
     reset_round(m, pos, vel, mass, charge, active, ship_gauges, ship_counters, torp_life, match_state, rules)
 
 
-@njit(cache=True)
+@jit()
 def step_match(m, actions, state, model, work, ship_gauges, ship_counters, torp_life,
                match_state, rng, rules, drifts, kicks):
     """Advance match ``m`` by one frame with ``actions[m, 0]`` and ``actions[m, 1]``.
@@ -322,7 +325,7 @@ def step_match(m, actions, state, model, work, ship_gauges, ship_counters, torp_
     mass = state.mass
     charge = state.charge
     active = state.active
-    force_params = model.fp
+    force_params = model.params
     match_state[m, FRAME] += 1
     for s in range(2):
         _control(m, s, actions[m, s], match_state[m, FRAME], pos, vel, mass, charge, active,
@@ -345,7 +348,7 @@ def step_match(m, actions, state, model, work, ship_gauges, ship_counters, torp_
                  match_state, rules)
 
 
-@njit(cache=True)
+@jit()
 def step_all(actions, state, model, ship_gauges, ship_counters, torp_life, match_state, rng,
              rules, drifts, kicks):
     """Advance every match by one frame (matches already over are left as they are)."""
@@ -357,7 +360,7 @@ def step_all(actions, state, model, ship_gauges, ship_counters, torp_life, match
                    match_state, rng, rules, drifts, kicks)
 
 
-@njit(cache=True)
+@jit()
 def reset_all(pos, vel, mass, charge, active, ship_gauges, ship_counters, torp_life, match_state, rules):
     for m in range(pos.shape[0]):
         for k in range(match_state.shape[1]):
@@ -365,7 +368,7 @@ def reset_all(pos, vel, mass, charge, active, ship_gauges, ship_counters, torp_l
         reset_round(m, pos, vel, mass, charge, active, ship_gauges, ship_counters, torp_life, match_state, rules)
 
 
-@njit(cache=True)
+@jit()
 def write_observation(m, seat, pos, vel, charge, active, ship_gauges, ship_counters, torp_life, match_state, rules, raw):
     """Match ``m`` seen from ``seat`` as the flat array of ``spacewar.protocol.raw_layout``:
     10 header numbers, the own ship's 15, the enemy's 15, then 8 per torpedo slot (own slots

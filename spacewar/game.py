@@ -15,13 +15,10 @@ import hashlib
 import numpy as np
 
 from engine import Batch, forces
-from engine.cache import project_cache
 
+from . import core
 from .protocol import Action, observation_from_raw, raw_length
 from .rules import Rules
-
-with project_cache("spacewar"):
-    from . import core
 
 
 def force_terms(rules):
@@ -130,6 +127,16 @@ class Game:
         core.reset_all(self.pos, self.vel, self.mass, self.charge, self.active, self.ship_gauges,
                        self.ship_counters, self.torp_life, self.match_state, self.rules_vector)
 
+    def _sync_with_batch(self):
+        """Follow a re-pack of the batch (a term's attribute changed, a term or slots added):
+        its parameter rows are then a new array, with the thrust at new columns, and the frame
+        must write into and step with those, never a stale copy."""
+        state, model = self.batch.kernel_arguments()
+        if model is not self.model or state.pos is not self.state.pos or state.n != self.state.n:
+            self.state, self.model = state, model
+            self.rules_vector[core.R_THRUST_OFF] = self.batch.parameter_columns(self.terms[-1],
+                                                                                "force")[0]
+
     # the engine's arrays of every match: (M, 2, bodies) positions and velocities, (M, bodies)
     # masses, charges and active flags (the batch's storage, which the compiled frame writes)
     pos = property(lambda self: self.state.pos)
@@ -149,6 +156,7 @@ class Game:
             self._actions[:] = core.NOOP
         else:
             self._actions[:] = self._encode(actions)
+        self._sync_with_batch()
         core.step_all(self._actions, self.state, self.model, self.ship_gauges, self.ship_counters,
                       self.torp_life, self.match_state, self.rng, self.rules_vector, self.drifts,
                       self.kicks)
@@ -241,11 +249,11 @@ class Game:
         recorded before the game ran on ``engine.Batch`` still verify: each term's packed
         floats, with the torus side in the pair terms' box entry (the batch's space now holds
         it) and only the two ships' thrust (the torpedo slots' is always zero)."""
-        row = self.model.fp[m]
-        foff = self.model.foff
+        row = self.model.params[m]
+        offsets = self.model.param_offsets
         parts = []
         for k, term in enumerate(self.terms):
-            block = row[foff[k]:foff[k + 1]].copy()
+            block = row[offsets[k]:offsets[k + 1]].copy()
             if isinstance(term, (forces.NBodyGravity, forces.Coulomb)):
                 block[term.layout(self.batch)["box"][0]] = self.batch.box
             if isinstance(term, forces.Thrust):

@@ -1,12 +1,12 @@
 """What every force term shares: packing its parameters for the compiled dispatcher.
 
 A force term is a Python object holding its parameters plus two numba kernels in its module:
-``accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work)`` adds its acceleration into
+``accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work)`` adds its acceleration into
 ``acc[:, :state.n]`` (``state`` an ``engine.state.State``, ``work`` an
 ``engine.state.Workspace`` of scratch for the large-N pair kernels), and
-``potential(t, state, fp, f0, f1, ip, i0, i1)`` returns its potential energy (0.0 when the
-term is not conservative). The term's float parameters are ``fp[f0:f1]``, laid out as its
-class's ``LAYOUT`` names them, and its integer ones (particle indices) ``ip[i0:i1]``. The
+``potential(t, state, params, f0, f1, indices, i0, i1)`` returns its potential energy (0.0 when the
+term is not conservative). The term's float parameters are ``params[f0:f1]``, laid out as its
+class's ``LAYOUT`` names them, and its integer ones (particle indices) ``indices[i0:i1]``. The
 simulation concatenates all declared terms into one table so that a step calls one compiled
 function and pays only for the declared terms.
 """
@@ -55,6 +55,9 @@ class Force:
     #: ``"dim"`` (the simulation's dimension), ``"slots"`` (its particle slots) or
     #: ``"items"`` (``len(term)``: one per spring)
     LAYOUT = ()
+    #: lower bounds of packed parameters, ``name -> (minimum, strict)``: what a value set per
+    #: system (``Batch.set_parameter``) is checked against, as the term's own checks would
+    BOUNDS = {}
     #: parameter name -> check(name, value) returning the value to store
     _settable = {}
 
@@ -69,7 +72,7 @@ class Force:
 
     # Subclasses override -------------------------------------------------------------
     def _pack(self, sim):
-        """Return ``(fp, ip)``: float64 and int64 1-D arrays of this term's parameters."""
+        """Return ``(params, indices)``: float64 and int64 1-D arrays of this term's parameters."""
         raise NotImplementedError
 
     def _check(self, sim):

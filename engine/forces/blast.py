@@ -12,7 +12,7 @@ import math
 import numpy as np
 from numba import njit
 
-from ._kernels import add_force
+from ._kernels import add_force, nearest_image
 from .base import Force, EMPTY_INTS
 from .._validate import finite_float, positive_float, vector
 
@@ -20,22 +20,23 @@ KIND = 9
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work):
+def accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work):
     pos = state.pos
     mass = state.mass
     active = state.active
     n = state.n
-    strength, scale, t0, duration = fp[f0], fp[f0 + 1], fp[f0 + 2], fp[f0 + 3]
+    box = state.box
+    strength, scale, t0, duration = params[f0], params[f0 + 1], params[f0 + 2], params[f0 + 3]
     if not (t0 <= t < t0 + duration):
         return
     dim = pos.shape[0]
-    cz = fp[f0 + 6] if dim == 3 else 0.0
+    cz = params[f0 + 6] if dim == 3 else 0.0
     for i in range(n):
         if not active[i]:
             continue
-        dx = pos[0, i] - fp[f0 + 4]
-        dy = pos[1, i] - fp[f0 + 5]
-        dz = pos[2, i] - cz if dim == 3 else 0.0
+        dx = nearest_image(pos[0, i] - params[f0 + 4], box)  # from the nearest image of the centre
+        dy = nearest_image(pos[1, i] - params[f0 + 5], box)
+        dz = nearest_image(pos[2, i] - cz, box) if dim == 3 else 0.0
         r = math.sqrt(dx * dx + dy * dy + dz * dz)
         if r == 0.0:
             continue
@@ -45,7 +46,7 @@ def accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work):
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def potential(t, state, fp, f0, f1, ip, i0, i1):
+def potential(t, state, params, f0, f1, indices, i0, i1):
     return 0.0
 
 
@@ -62,6 +63,7 @@ class Blast(Force):
 
     KIND = KIND
     LAYOUT = (("strength", ()), ("scale", ()), ("start", ()), ("duration", ()), ("center", ("dim",)))
+    BOUNDS = {"scale": (0.0, True), "duration": (0.0, True)}
     _settable = {"center": vector, "strength": finite_float, "scale": positive_float,
                  "start": finite_float, "duration": _duration}
 

@@ -49,14 +49,14 @@ def _submerged_integral(d, radius, dim):
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work):
+def accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work):
     pos = state.pos
     mass = state.mass
     radius = state.radius
     active = state.active
     n = state.n
-    level, rho_g = fp[f0], fp[f0 + 1]
-    up = ip[i0]
+    level, rho_g = params[f0], params[f0 + 1]
+    up = indices[i0]
     dim = pos.shape[0]
     for i in range(n):
         if not active[i] or radius[i] == 0.0:
@@ -72,13 +72,13 @@ def accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work):
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def potential(t, state, fp, f0, f1, ip, i0, i1):
+def potential(t, state, params, f0, f1, indices, i0, i1):
     pos = state.pos
     radius = state.radius
     active = state.active
     n = state.n
-    level, rho_g = fp[f0], fp[f0 + 1]
-    up = ip[i0]
+    level, rho_g = params[f0], params[f0 + 1]
+    up = indices[i0]
     dim = pos.shape[0]
     u = 0.0
     for i in range(n):
@@ -104,6 +104,7 @@ class Buoyancy(Force):
 
     KIND = KIND
     LAYOUT = (("level", ()), ("density_times_g", ()))
+    BOUNDS = {"density_times_g": (0.0, False)}
     conservative = True
     _settable = {"level": finite_float, "density": nonnegative_float, "g": positive_float,
                  "up": _axis}

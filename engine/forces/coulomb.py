@@ -21,16 +21,16 @@ KIND = 3
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work):
+def accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work):
     pos = state.pos
     mass = state.mass
     charge = state.charge
     active = state.active
     n = state.n
     space = state.box
-    k = fp[f0]
-    eps2 = fp[f0 + 1]
-    box = fp[f0 + 2] if fp[f0 + 2] > 0.0 else space  # a deprecated own box, else the space's
+    k = params[f0]
+    eps2 = params[f0 + 1]
+    box = params[f0 + 2] if params[f0 + 2] > 0.0 else space  # a deprecated own box, else the space's
     dim = pos.shape[0]
     if pairwise.usable(n, work):
         pairwise.coulomb(pos, mass, charge, active, n, k, eps2, box, acc, work)
@@ -50,15 +50,15 @@ def accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work):
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def potential(t, state, fp, f0, f1, ip, i0, i1):
+def potential(t, state, params, f0, f1, indices, i0, i1):
     pos = state.pos
     charge = state.charge
     active = state.active
     n = state.n
     space = state.box
-    k = fp[f0]
-    eps2 = fp[f0 + 1]
-    box = fp[f0 + 2] if fp[f0 + 2] > 0.0 else space  # a deprecated own box, else the space's
+    k = params[f0]
+    eps2 = params[f0 + 1]
+    box = params[f0 + 2] if params[f0 + 2] > 0.0 else space  # a deprecated own box, else the space's
     dim = pos.shape[0]
     u = 0.0
     for i in range(n):
@@ -81,6 +81,7 @@ class Coulomb(Force):
 
     KIND = KIND
     LAYOUT = (("k", ()), ("softening_squared", ()), ("box", ()))
+    BOUNDS = {"softening_squared": (0.0, False), "box": (0.0, False)}
     conservative = True
     _settable = {"k": finite_float, "softening": nonnegative_float,
                  "box": optional(positive_float)}

@@ -1,8 +1,8 @@
 """The compiled force table: one call evaluates every declared term, and only those.
 
-A simulation's terms are packed into an ``engine.state.Model(kinds, fp, foff, ip, ioff)``:
-term ``s`` has kind ``kinds[s]`` and parameters ``fp[foff[s]:foff[s+1]]`` and
-``ip[ioff[s]:ioff[s+1]]``. The branch per term per evaluation is negligible against the work of
+A simulation's terms are packed into an ``engine.state.Model(kinds, params, param_offsets, indices, index_offsets)``:
+term ``s`` has kind ``kinds[s]`` and parameters ``params[param_offsets[s]:param_offsets[s+1]]`` and
+``indices[index_offsets[s]:index_offsets[s+1]]``. The branch per term per evaluation is negligible against the work of
 the terms themselves, and having one signature means every integrator is compiled once and
 cached, whatever the scene. Every module of ``engine.forces.registry.TERMS`` has a branch in
 both dispatchers (a test holds it to that).
@@ -32,36 +32,36 @@ def accelerations(t, state, model, acc, work):
         for i in range(n):
             acc[k, i] = 0.0
     kinds = model.kinds
-    fp = model.fp
-    foff = model.foff
-    ip = model.ip
-    ioff = model.ioff
+    params = model.params
+    param_offsets = model.param_offsets
+    indices = model.indices
+    index_offsets = model.index_offsets
     for s in range(kinds.shape[0]):
-        f0 = foff[s]
-        f1 = foff[s + 1]
-        i0 = ioff[s]
-        i1 = ioff[s + 1]
+        f0 = param_offsets[s]
+        f1 = param_offsets[s + 1]
+        i0 = index_offsets[s]
+        i1 = index_offsets[s + 1]
         kind = kinds[s]
         if kind == gravity.KIND:
-            gravity.accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work)
+            gravity.accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work)
         elif kind == point_mass.KIND:
-            point_mass.accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work)
+            point_mass.accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work)
         elif kind == uniform_gravity.KIND:
-            uniform_gravity.accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work)
+            uniform_gravity.accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work)
         elif kind == coulomb.KIND:
-            coulomb.accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work)
+            coulomb.accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work)
         elif kind == springs.KIND:
-            springs.accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work)
+            springs.accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work)
         elif kind == drag.KIND:
-            drag.accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work)
+            drag.accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work)
         elif kind == thrust.KIND:
-            thrust.accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work)
+            thrust.accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work)
         elif kind == wind.KIND:
-            wind.accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work)
+            wind.accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work)
         elif kind == buoyancy.KIND:
-            buoyancy.accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work)
+            buoyancy.accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work)
         elif kind == blast.KIND:
-            blast.accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work)
+            blast.accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work)
     pinned = state.pinned
     for i in range(n):
         if pinned[i]:
@@ -73,37 +73,37 @@ def accelerations(t, state, model, acc, work):
 def potential_terms(t, state, model, out):
     """Write each term's potential energy into ``out[s]`` (0 for non-conservative terms)."""
     kinds = model.kinds
-    fp = model.fp
-    foff = model.foff
-    ip = model.ip
-    ioff = model.ioff
+    params = model.params
+    param_offsets = model.param_offsets
+    indices = model.indices
+    index_offsets = model.index_offsets
     for s in range(kinds.shape[0]):
-        f0 = foff[s]
-        f1 = foff[s + 1]
-        i0 = ioff[s]
-        i1 = ioff[s + 1]
+        f0 = param_offsets[s]
+        f1 = param_offsets[s + 1]
+        i0 = index_offsets[s]
+        i1 = index_offsets[s + 1]
         kind = kinds[s]
         u = 0.0
         if kind == gravity.KIND:
-            u = gravity.potential(t, state, fp, f0, f1, ip, i0, i1)
+            u = gravity.potential(t, state, params, f0, f1, indices, i0, i1)
         elif kind == point_mass.KIND:
-            u = point_mass.potential(t, state, fp, f0, f1, ip, i0, i1)
+            u = point_mass.potential(t, state, params, f0, f1, indices, i0, i1)
         elif kind == uniform_gravity.KIND:
-            u = uniform_gravity.potential(t, state, fp, f0, f1, ip, i0, i1)
+            u = uniform_gravity.potential(t, state, params, f0, f1, indices, i0, i1)
         elif kind == coulomb.KIND:
-            u = coulomb.potential(t, state, fp, f0, f1, ip, i0, i1)
+            u = coulomb.potential(t, state, params, f0, f1, indices, i0, i1)
         elif kind == springs.KIND:
-            u = springs.potential(t, state, fp, f0, f1, ip, i0, i1)
+            u = springs.potential(t, state, params, f0, f1, indices, i0, i1)
         elif kind == drag.KIND:
-            u = drag.potential(t, state, fp, f0, f1, ip, i0, i1)
+            u = drag.potential(t, state, params, f0, f1, indices, i0, i1)
         elif kind == thrust.KIND:
-            u = thrust.potential(t, state, fp, f0, f1, ip, i0, i1)
+            u = thrust.potential(t, state, params, f0, f1, indices, i0, i1)
         elif kind == wind.KIND:
-            u = wind.potential(t, state, fp, f0, f1, ip, i0, i1)
+            u = wind.potential(t, state, params, f0, f1, indices, i0, i1)
         elif kind == buoyancy.KIND:
-            u = buoyancy.potential(t, state, fp, f0, f1, ip, i0, i1)
+            u = buoyancy.potential(t, state, params, f0, f1, indices, i0, i1)
         elif kind == blast.KIND:
-            u = blast.potential(t, state, fp, f0, f1, ip, i0, i1)
+            u = blast.potential(t, state, params, f0, f1, indices, i0, i1)
         out[s] = u
 
 
@@ -113,18 +113,18 @@ def pack(terms, sim):
     Every term is re-checked against ``sim`` first (indices in range, dimension), so nothing
     changed since it was added can reach the kernels unchecked.
     """
-    fps, ips = [], []
+    param_blocks, index_blocks = [], []
     for term in terms:
         term._check(sim)
     for term in terms:
-        fp, ip = term._pack(sim)
-        fps.append(np.ascontiguousarray(fp, dtype=np.float64))
-        ips.append(np.ascontiguousarray(ip, dtype=np.int64))
+        params, indices = term._pack(sim)
+        param_blocks.append(np.ascontiguousarray(params, dtype=np.float64))
+        index_blocks.append(np.ascontiguousarray(indices, dtype=np.int64))
     kinds = np.array([term.KIND for term in terms], dtype=np.int64)
-    foff = np.zeros(len(terms) + 1, dtype=np.int64)
-    ioff = np.zeros(len(terms) + 1, dtype=np.int64)
-    foff[1:] = np.cumsum([a.shape[0] for a in fps]) if terms else []
-    ioff[1:] = np.cumsum([a.shape[0] for a in ips]) if terms else []
-    fp = np.concatenate(fps) if fps else np.zeros(0)
-    ip = np.concatenate(ips) if ips else np.zeros(0, dtype=np.int64)
-    return Model(kinds, fp, foff, ip, ioff)
+    param_offsets = np.zeros(len(terms) + 1, dtype=np.int64)
+    index_offsets = np.zeros(len(terms) + 1, dtype=np.int64)
+    param_offsets[1:] = np.cumsum([a.shape[0] for a in param_blocks]) if terms else []
+    index_offsets[1:] = np.cumsum([a.shape[0] for a in index_blocks]) if terms else []
+    params = np.concatenate(param_blocks) if param_blocks else np.zeros(0)
+    indices = np.concatenate(index_blocks) if index_blocks else np.zeros(0, dtype=np.int64)
+    return Model(kinds, params, param_offsets, indices, index_offsets)

@@ -15,14 +15,14 @@ KIND = 5
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work):
+def accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work):
     pos = state.pos
     vel = state.vel
     mass = state.mass
     active = state.active
     n = state.n
-    c1 = fp[f0]
-    c2 = fp[f0 + 1]
+    c1 = params[f0]
+    c2 = params[f0 + 1]
     dim = pos.shape[0]
     for i in range(n):
         if not active[i]:
@@ -35,7 +35,7 @@ def accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work):
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def potential(t, state, fp, f0, f1, ip, i0, i1):
+def potential(t, state, params, f0, f1, indices, i0, i1):
     return 0.0
 
 
@@ -44,6 +44,7 @@ class Drag(Force):
 
     KIND = KIND
     LAYOUT = (("linear", ()), ("quadratic", ()))
+    BOUNDS = {"linear": (0.0, False), "quadratic": (0.0, False)}
     _settable = {"linear": nonnegative_float, "quadratic": nonnegative_float}
 
     def __init__(self, linear=0.0, quadratic=0.0):

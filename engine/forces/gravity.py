@@ -64,18 +64,18 @@ def _open_space_3d(pos, mass, n, G, eps2, acc):
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work):
+def accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work):
     pos = state.pos
     mass = state.mass
     active = state.active
     test = state.test
     n = state.n
     space = state.box
-    G = fp[f0]
-    eps2 = fp[f0 + 1]
-    box = fp[f0 + 2] if fp[f0 + 2] > 0.0 else space  # a deprecated own box, else the space's
+    G = params[f0]
+    eps2 = params[f0 + 1]
+    box = params[f0 + 2] if params[f0 + 2] > 0.0 else space  # a deprecated own box, else the space's
     if pairwise.usable(n, work):
-        single = fp[f0 + 3] != 0.0
+        single = params[f0 + 3] != 0.0
         pairwise.gravity(pos, mass, active, test, n, G, eps2, box, single, acc, work)
         return
     three = pos.shape[0] == 3
@@ -119,16 +119,16 @@ def accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work):
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def potential(t, state, fp, f0, f1, ip, i0, i1):
+def potential(t, state, params, f0, f1, indices, i0, i1):
     pos = state.pos
     mass = state.mass
     active = state.active
     test = state.test
     n = state.n
     space = state.box
-    G = fp[f0]
-    eps2 = fp[f0 + 1]
-    box = fp[f0 + 2] if fp[f0 + 2] > 0.0 else space  # a deprecated own box, else the space's
+    G = params[f0]
+    eps2 = params[f0 + 1]
+    box = params[f0 + 2] if params[f0 + 2] > 0.0 else space  # a deprecated own box, else the space's
     dim = pos.shape[0]
     u = 0.0
     for i in range(n):
@@ -160,6 +160,7 @@ class NBodyGravity(Force):
 
     KIND = KIND
     LAYOUT = (("G", ()), ("softening_squared", ()), ("box", ()), ("float32", ()))
+    BOUNDS = {"G": (0.0, False), "softening_squared": (0.0, False), "box": (0.0, False)}
     conservative = True
 
     PRECISIONS = ("float64", "float32")

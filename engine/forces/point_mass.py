@@ -10,6 +10,7 @@ import math
 
 from numba import njit
 
+from ._kernels import nearest_image
 from .base import Force, EMPTY_INTS
 from .._validate import index_array, positive_float, nonnegative_float, vector
 
@@ -19,29 +20,30 @@ KIND = 1
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _target(ip, i0, i1, k):
-    """The k-th particle the attractor acts on: every particle, or only those listed in ip."""
-    return k if i1 == i0 else ip[i0 + k]
+def _target(indices, i0, i1, k):
+    """The k-th particle the attractor acts on: every particle, or only those listed in indices."""
+    return k if i1 == i0 else indices[i0 + k]
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work):
+def accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work):
     pos = state.pos
     active = state.active
     n = state.n
-    mu = fp[f0]
-    eps2 = fp[f0 + 1]
+    box = state.box
+    mu = params[f0]
+    eps2 = params[f0 + 1]
     dim = pos.shape[0]
-    cx = fp[f0 + 2]
-    cy = fp[f0 + 3]
-    cz = fp[f0 + 4] if dim == 3 else 0.0
+    cx = params[f0 + 2]
+    cy = params[f0 + 3]
+    cz = params[f0 + 4] if dim == 3 else 0.0
     for k in range(n if i1 == i0 else i1 - i0):
-        i = _target(ip, i0, i1, k)
+        i = _target(indices, i0, i1, k)
         if i >= n or not active[i]:
             continue
-        dx = pos[0, i] - cx
-        dy = pos[1, i] - cy
-        dz = pos[2, i] - cz if dim == 3 else 0.0
+        dx = nearest_image(pos[0, i] - cx, box)  # the nearest image of the attractor
+        dy = nearest_image(pos[1, i] - cy, box)
+        dz = nearest_image(pos[2, i] - cz, box) if dim == 3 else 0.0
         r2 = dx * dx + dy * dy + dz * dz + eps2
         s = mu / (r2 * math.sqrt(r2))
         acc[0, i] -= s * dx
@@ -51,22 +53,23 @@ def accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work):
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def potential(t, state, fp, f0, f1, ip, i0, i1):
+def potential(t, state, params, f0, f1, indices, i0, i1):
     pos = state.pos
     mass = state.mass
     active = state.active
     n = state.n
-    mu = fp[f0]
-    eps2 = fp[f0 + 1]
+    box = state.box
+    mu = params[f0]
+    eps2 = params[f0 + 1]
     dim = pos.shape[0]
     u = 0.0
     for j in range(n if i1 == i0 else i1 - i0):
-        i = _target(ip, i0, i1, j)
+        i = _target(indices, i0, i1, j)
         if i >= n or not active[i]:
             continue
         r2 = eps2
         for k in range(dim):
-            d = pos[k, i] - fp[f0 + 2 + k]
+            d = nearest_image(pos[k, i] - params[f0 + 2 + k], box)
             r2 += d * d
         u -= mu * mass[i] / math.sqrt(r2)
     return u
@@ -81,6 +84,7 @@ class PointMass(Force):
 
     KIND = KIND
     LAYOUT = (("mu", ()), ("softening_squared", ()), ("pos", ("dim",)))
+    BOUNDS = {"mu": (0.0, True), "softening_squared": (0.0, False)}
     conservative = True
     _settable = {"softening": nonnegative_float}
 

@@ -16,7 +16,7 @@ import math
 import numpy as np
 from numba import njit
 
-from ._kernels import add_force, delta
+from ._kernels import add_force, delta, delta_periodic
 from .base import Force
 from .._validate import index_array, per_item, vector, positive_float, nonnegative_float
 
@@ -24,22 +24,23 @@ KIND = 4
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work):
+def accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work):
     pos = state.pos
     vel = state.vel
     mass = state.mass
     active = state.active
+    box = state.box  # a spring across the edge of a periodic space joins the nearest images
     dim = pos.shape[0]
     m = (i1 - i0) // 2
     for s in range(m):
-        a = ip[i0 + 2 * s]
-        b = ip[i0 + 2 * s + 1]
+        a = indices[i0 + 2 * s]
+        b = indices[i0 + 2 * s + 1]
         if not (active[a] and active[b]):
             continue
-        k = fp[f0 + s]
-        rest = fp[f0 + m + s]
-        c = fp[f0 + 2 * m + s]
-        dx, dy, dz = delta(pos, a, b, dim)
+        k = params[f0 + s]
+        rest = params[f0 + m + s]
+        c = params[f0 + 2 * m + s]
+        dx, dy, dz = delta_periodic(pos, a, b, dim, box)
         r2 = dx * dx + dy * dy + dz * dz
         r = math.sqrt(r2)
         scale = k if rest == 0.0 else k * (1.0 - rest / r)
@@ -51,20 +52,21 @@ def accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work):
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def potential(t, state, fp, f0, f1, ip, i0, i1):
+def potential(t, state, params, f0, f1, indices, i0, i1):
     pos = state.pos
     active = state.active
+    box = state.box
     dim = pos.shape[0]
     m = (i1 - i0) // 2
     u = 0.0
     for s in range(m):
-        a = ip[i0 + 2 * s]
-        b = ip[i0 + 2 * s + 1]
+        a = indices[i0 + 2 * s]
+        b = indices[i0 + 2 * s + 1]
         if not (active[a] and active[b]):
             continue
-        dx, dy, dz = delta(pos, a, b, dim)
-        stretch = math.sqrt(dx * dx + dy * dy + dz * dz) - fp[f0 + m + s]
-        u += 0.5 * fp[f0 + s] * stretch * stretch
+        dx, dy, dz = delta_periodic(pos, a, b, dim, box)
+        stretch = math.sqrt(dx * dx + dy * dy + dz * dz) - params[f0 + m + s]
+        u += 0.5 * params[f0 + s] * stretch * stretch
     return u
 
 
@@ -78,6 +80,7 @@ class Springs(Force):
 
     KIND = KIND
     LAYOUT = (("k", ("items",)), ("rest_length", ("items",)), ("damping", ("items",)))
+    BOUNDS = {"k": (0.0, False), "rest_length": (0.0, False), "damping": (0.0, False)}
     conservative = True
 
     def __init__(self, pairs, k=10.0, rest_length=1.0, damping=0.0):
@@ -109,8 +112,8 @@ class Springs(Force):
                              f"(the simulation has {sim.n} particles)")
 
     def _pack(self, sim):
-        fp = np.concatenate((self.k, self.rest_length, self.damping))
-        return fp, self.pairs.reshape(-1).copy()
+        params = np.concatenate((self.k, self.rest_length, self.damping))
+        return params, self.pairs.reshape(-1).copy()
 
     def __repr__(self):
         return f"Springs({len(self)} springs)"

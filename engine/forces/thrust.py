@@ -14,7 +14,7 @@ KIND = 6
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work):
+def accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work):
     pos = state.pos
     mass = state.mass
     active = state.active
@@ -24,12 +24,12 @@ def accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work):
     for i in range(count):
         if not active[i]:
             continue
-        f2 = fp[f0 + i * dim + 2] if dim == 3 else 0.0
-        add_force(acc, i, dim, fp[f0 + i * dim], fp[f0 + i * dim + 1], f2, mass[i])
+        f2 = params[f0 + i * dim + 2] if dim == 3 else 0.0
+        add_force(acc, i, dim, params[f0 + i * dim], params[f0 + i * dim + 1], f2, mass[i])
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def potential(t, state, fp, f0, f1, ip, i0, i1):
+def potential(t, state, params, f0, f1, indices, i0, i1):
     return 0.0
 
 

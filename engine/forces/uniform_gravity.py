@@ -11,7 +11,7 @@ KIND = 2
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work):
+def accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work):
     pos = state.pos
     active = state.active
     n = state.n
@@ -20,11 +20,11 @@ def accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work):
         if not active[i]:
             continue
         for k in range(dim):
-            acc[k, i] += fp[f0 + k]
+            acc[k, i] += params[f0 + k]
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def potential(t, state, fp, f0, f1, ip, i0, i1):
+def potential(t, state, params, f0, f1, indices, i0, i1):
     pos = state.pos
     mass = state.mass
     active = state.active
@@ -35,7 +35,7 @@ def potential(t, state, fp, f0, f1, ip, i0, i1):
         if not active[i]:
             continue
         for k in range(dim):
-            u -= mass[i] * fp[f0 + k] * pos[k, i]
+            u -= mass[i] * params[f0 + k] * pos[k, i]
     return u
 
 

@@ -12,7 +12,7 @@ import math
 import numpy as np
 from numba import njit
 
-from ._kernels import add_force
+from ._kernels import add_force, delta_periodic
 from .base import Force
 from .._validate import index_array, vector
 
@@ -20,26 +20,23 @@ KIND = 7
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work):
+def accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work):
     pos = state.pos
     mass = state.mass
     active = state.active
-    wx, wy, wz = fp[f0], fp[f0 + 1], fp[f0 + 2]
+    box = state.box
+    wx, wy, wz = params[f0], params[f0 + 1], params[f0 + 2]
     wn = math.sqrt(wx * wx + wy * wy + wz * wz)
     if wn == 0.0:
         return
     for s in range((i1 - i0) // 3):
-        a = ip[i0 + 3 * s]
-        b = ip[i0 + 3 * s + 1]
-        c = ip[i0 + 3 * s + 2]
+        a = indices[i0 + 3 * s]
+        b = indices[i0 + 3 * s + 1]
+        c = indices[i0 + 3 * s + 2]
         if not (active[a] and active[b] and active[c]):
             continue
-        ux = pos[0, b] - pos[0, a]
-        uy = pos[1, b] - pos[1, a]
-        uz = pos[2, b] - pos[2, a]
-        vx = pos[0, c] - pos[0, a]
-        vy = pos[1, c] - pos[1, a]
-        vz = pos[2, c] - pos[2, a]
+        ux, uy, uz = delta_periodic(pos, a, b, 3, box)  # edges by the nearest image
+        vx, vy, vz = delta_periodic(pos, a, c, 3, box)
         nx = uy * vz - uz * vy
         ny = uz * vx - ux * vz
         nz = ux * vy - uy * vx
@@ -50,7 +47,7 @@ def accumulate(t, state, fp, f0, f1, ip, i0, i1, acc, work):
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def potential(t, state, fp, f0, f1, ip, i0, i1):
+def potential(t, state, params, f0, f1, indices, i0, i1):
     return 0.0
 
 

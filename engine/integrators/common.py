@@ -25,11 +25,13 @@ TIME_OVERFLOW = -3
 @njit(cache=True, error_model="numpy", inline="always")
 def drift(pos, vel, mask, n, h, box):
     """p <- p + h v, v masked to 0 for inactive and pinned particles (so they stay exactly
-    put), then wrapped onto the periodic space of side ``box`` (none when box is 0)."""
+    put); the moving ones are then wrapped onto the periodic space of side ``box`` (none when
+    box is 0)."""
     if box > 0.0:
         for k in range(pos.shape[0]):
             for i in range(n):
-                pos[k, i] = wrap_scalar(pos[k, i] + (h * mask[i]) * vel[k, i], box)
+                moved = pos[k, i] + (h * mask[i]) * vel[k, i]
+                pos[k, i] = wrap_scalar(moved, box) if mask[i] != 0.0 else moved
         return
     for k in range(pos.shape[0]):
         for i in range(n):

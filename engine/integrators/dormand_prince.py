@@ -124,8 +124,11 @@ def advance(t, h, steps, state, model, work, vdep, t_end, tol):
                     status = first_nonfinite_array(kv[0], active, n)
                 return t, h, done, status if status >= 0 else STEP_COLLAPSED
             continue
-        pos[:, :n] = sx
-        vel[:, :n] = sv
+        for k in range(dim):  # the moving particles take the step; the others stay as they are
+            for i in range(n):
+                if mask[i] != 0.0:
+                    pos[k, i] = sx[k, i]
+                    vel[k, i] = sv[k, i]
         wrap_positions(pos, mask, n, state.box)
         t = t_end if last else t + h_try
         kx[0, :, :] = kx[6]

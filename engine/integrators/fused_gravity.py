@@ -38,7 +38,7 @@ def applies(state, model):
     """Is this call the fused case: one open-space gravity term, few bodies, none of them test
     particles or pinned?"""
     kinds = model.kinds
-    if kinds.shape[0] != 1 or kinds[0] != gravity.KIND or model.fp[model.foff[0] + 2] != 0.0:
+    if kinds.shape[0] != 1 or kinds[0] != gravity.KIND or model.params[model.param_offsets[0] + 2] != 0.0:
         return False
     n = state.n
     if state.box != 0.0 or n >= pairwise.PARALLEL_MIN or state.pos.shape[0] > 3:

@@ -68,9 +68,9 @@ def force_evaluations(name):
 def advance(t, h, steps, state, model, work, vdep, t_end, drifts, kicks):
     """``steps`` steps of the scheme (drift ``drifts[k] h``, then kick ``kicks[k] h``)."""
     if fused_gravity.applies(state, model):
-        f0 = model.foff[0]
+        f0 = model.param_offsets[0]
         return fused_gravity.advance(t, h, steps, state.pos, state.vel, state.mass, state.active,
-                                     state.n, model.fp[f0], model.fp[f0 + 1], drifts, kicks)
+                                     state.n, model.params[f0], model.params[f0 + 1], drifts, kicks)
     pos = state.pos
     vel = state.vel
     active = state.active

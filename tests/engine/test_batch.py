@@ -179,7 +179,7 @@ def test_a_system_that_blows_up_keeps_its_last_finite_state_and_is_named():
     (lambda: Batch(systems=2, dim=4), "dim must be 2 or 3"),
     (lambda: Batch(systems=2, integrator="rk5"), "integrator must be one of"),
     (lambda: Batch(systems=2, dt=0.0), "dt must be non-zero"),
-    (lambda: Batch(systems=2, box=-1.0), "box must be > 0"),
+    (lambda: Batch(systems=2, box=-1.0), "box must be >= 0"),
 ])
 def test_bad_construction_is_refused_naming_the_field(call, message):
     with pytest.raises((ValueError, TypeError), match=message):
@@ -212,3 +212,86 @@ def test_a_removed_force_stops_acting_in_every_system():
     batch.add_force(forces.Drag(linear=5.0))
     batch.step()
     np.testing.assert_array_equal(batch.vel[:, 0], [[0.5, 0.0], [0.5, 0.0]])
+
+
+def test_slots_added_after_a_per_system_thrust_keep_every_systems_thrust():
+    batch = Batch(systems=2, dim=2, integrator="symplectic_euler", dt=1.0)
+    batch.add_many(mass=1.0, pos=np.zeros((2, 2)))
+    thrust = batch.add_force(forces.Thrust())
+    batch.set_parameter(thrust, "force", [[[1.0, 0.0], [0.0, 2.0]], [[3.0, 0.0], [0.0, 4.0]]])
+    batch.add_many(mass=1.0, pos=np.zeros((1, 2)))  # a third slot in every system
+    np.testing.assert_array_equal(batch.parameter(thrust, "force"),
+                                  [[[1, 0], [0, 2], [0, 0]], [[3, 0], [0, 4], [0, 0]]])
+    batch.step()
+    np.testing.assert_array_equal(batch.vel[:, :, :], [[[1, 0], [0, 2], [0, 0]],
+                                                        [[3, 0], [0, 4], [0, 0]]])
+
+
+@pytest.mark.parametrize("term, name, value, message", [
+    (forces.Drag(linear=0.1), "linear", -1.0, r"Drag.linear must be finite and >= 0.0, got -1.0"),
+    (forces.PointMass(mu=1.0), "mu", 0.0, r"PointMass.mu must be finite and > 0.0, got 0.0"),
+    (forces.NBodyGravity(), "softening_squared", -4.0, r"softening_squared must be finite and >= 0.0"),
+    (forces.Blast(center=(0.0, 0.0), strength=1.0), "scale", 0.0, r"Blast.scale must be finite and > 0.0"),
+])
+def test_per_system_values_are_checked_as_the_term_checks_them(term, name, value, message):
+    batch = Batch(systems=3, dim=2)
+    batch.add_many(mass=1.0, pos=np.zeros((2, 2)))
+    batch.add_force(term)
+    before = batch.parameter(term, name)
+    values = np.broadcast_to(before, before.shape).copy()
+    values[1] = value
+    with pytest.raises(ValueError, match=message + r".*\(system 1\); nothing was changed"):
+        batch.set_parameter(term, name, values)
+    np.testing.assert_array_equal(batch.parameter(term, name), before)
+
+
+def test_a_failed_rk45_system_keeps_its_step_as_a_simulation_does():
+    pos = [[0.0, 0.0], [1e-9, 0.0]]
+    batch = Batch(systems=1, dim=2, integrator="rk45", dt=0.1)
+    batch.add_many(mass=1.0, pos=pos)
+    batch.add_force(forces.NBodyGravity())
+    sim = Simulation(dim=2, integrator="rk45", dt=0.1)
+    sim.add_many(mass=1.0, pos=pos)
+    sim.add_force(forces.NBodyGravity())
+    for run in (batch.step, sim.step):
+        with pytest.raises(SimulationError):
+            run(1000)
+    assert batch.dts[0] == sim.dt and batch.t[0] == sim.t
+
+
+def test_potential_energies_of_many_terms_add_as_a_simulation_adds_them():
+    scene = _scene(seed=8, systems=3)
+    batch, _ = _batch("leapfrog", scene)
+    extra = [forces.PointMass(mu=0.1 * (k + 1), pos=(0.05 * k, -0.03 * k), softening=0.1)
+             for k in range(10)]
+    for term in extra:
+        batch.add_force(term)
+    for m in range(3):
+        sim = _alone("leapfrog", scene, m)
+        for k in range(10):
+            sim.add_force(forces.PointMass(mu=0.1 * (k + 1), pos=(0.05 * k, -0.03 * k),
+                                           softening=0.1))
+        assert batch.potential_energy()[m] == sim.potential_energy()
+
+
+def test_inactive_and_pinned_particles_stay_where_they_are_in_a_periodic_space():
+    import engine as _engine
+    for integrator in _engine.INTEGRATORS:
+        sim = Simulation(dim=2, integrator=integrator, dt=0.01, box=1.0)
+        sim.add_many(mass=1.0, pos=[(0.7, 0.0), (0.2, 0.0), (0.0, 0.3)],
+                     vel=[(0.0, 0.0), (1.0, 0.0), (0.5, 0.0)])
+        sim.add_force(forces.UniformGravity(g=(0.0, -1.0)))
+        sim.deactivate(1)
+        sim.pin(0)
+        sim.step(20)
+        assert sim.pos[0, 0] == 0.7 and sim.pos[1, 0] == 0.2, integrator  # parked, not wrapped
+        assert -0.5 <= sim.pos[2, 0] < 0.5
+
+
+def test_a_spring_across_the_edge_of_a_periodic_space_joins_the_nearest_images():
+    sim = Simulation(dim=2, box=1.0)
+    sim.add_many(mass=1.0, pos=[(0.49, 0.0), (-0.49, 0.0)])
+    sim.add_force(forces.Springs([(0, 1)], k=10.0, rest_length=0.02))
+    assert sim.potential_energy() == pytest.approx(0.0, abs=1e-24)
+    sim.pos[1] = (-0.48, 0.0)  # stretched by 0.01 through the edge
+    assert sim.potential_energy() == pytest.approx(0.5 * 10.0 * 0.01 ** 2, rel=1e-9)

@@ -58,18 +58,18 @@ def test_each_kind_reaches_both_dispatchers_through_its_own_kernels(entry):
     via_dispatch = np.zeros((dim, n))
     dispatch.accelerations(0.0, state, model, via_dispatch, work)
     direct = np.zeros((dim, n))
-    entry.accumulate(0.0, state, model.fp, model.foff[0], model.foff[1], model.ip,
-                     model.ioff[0], model.ioff[1], direct, work)
+    entry.accumulate(0.0, state, model.params, model.param_offsets[0], model.param_offsets[1], model.indices,
+                     model.index_offsets[0], model.index_offsets[1], direct, work)
     np.testing.assert_array_equal(via_dispatch, direct)
     assert np.abs(direct).max() > 0.0  # the example really acts
     out = np.zeros(1)
     dispatch.potential_terms(0.0, state, model, out)
-    u = entry.potential(0.0, state, model.fp, model.foff[0], model.foff[1], model.ip,
-                        model.ioff[0], model.ioff[1])
+    u = entry.potential(0.0, state, model.params, model.param_offsets[0], model.param_offsets[1], model.indices,
+                        model.index_offsets[0], model.index_offsets[1])
     assert out[0] == u
     assert (u != 0.0) == entry.conservative  # only conservative terms have a potential
     # a kind the registry does not know reaches neither
-    unknown = Model(np.array([99]), model.fp, model.foff, model.ip, model.ioff)
+    unknown = Model(np.array([99]), model.params, model.param_offsets, model.indices, model.index_offsets)
     dispatch.accelerations(0.0, state, unknown, via_dispatch, work)
     assert not via_dispatch.any()
 
@@ -80,13 +80,13 @@ def test_the_layout_names_every_packed_float(entry):
     sim, term = _example(entry, dim)
     layout = term.layout(sim)
     _, model = sim.kernel_arguments()
-    packed = model.foff[1] - model.foff[0]
+    packed = model.param_offsets[1] - model.param_offsets[0]
     assert sum(int(np.prod(shape)) for _, shape in layout.values()) == packed
     for name, (offset, shape) in layout.items():
         value = sim.parameter(term, name)
         assert value.shape == shape
         np.testing.assert_array_equal(value.reshape(-1),
-                                      model.fp[model.foff[0] + offset:][:value.size])
+                                      model.params[model.param_offsets[0] + offset:][:value.size])
 
 
 def test_parameters_read_by_name():

@@ -342,7 +342,7 @@ def engine_integrators():
 
 
 def test_box_is_checked():
-    with pytest.raises(ValueError, match="box must be > 0, got -1.0"):
+    with pytest.raises(ValueError, match="box must be >= 0, got -1.0"):
         Simulation(box=-1.0)
     with pytest.raises(TypeError, match="box must be a real number, got 'x'"):
         Simulation(box="x")

@@ -412,3 +412,17 @@ def test_frames_in_finished_rounds_are_counted():
         game.step()
     snap = game.snapshot(0)
     assert snap["frames_in_finished_rounds"] == 2 * 50 == game.frame[0]  # 50 frames each
+
+
+def test_the_frame_follows_a_repack_of_its_batch():
+    """A term changed after the game was made re-packs the batch's parameter rows: the frame
+    steps with, and writes the thrust into, the new rows, never a stale copy."""
+    game = Game(Rules(), seeds=[0], rounds=1)
+    star = game.terms[0]
+    star.softening = 0.2
+    game.step(np.array([[3 + 1, 1]]))  # ship 0 thrusts
+    _, model = game.batch.kernel_arguments()
+    assert game.model is model
+    assert game.batch.parameter(star, "softening_squared")[0] == pytest.approx(0.04)
+    thrust = game.batch.parameter(game.terms[-1], "force")[0, 0]
+    assert np.abs(thrust).max() > 0.0
