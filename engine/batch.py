@@ -28,7 +28,6 @@ Compiled code of your own (a game's frame) takes ``batch.kernel_arguments()``: a
 ``(M, F)``; ``system_state(state, m)`` and ``system_model(model, m)`` give one system's
 named tuples, and ``advance_system`` steps it with a splitting scheme.
 """
-import math
 import numbers
 
 import numpy as np
@@ -45,7 +44,8 @@ from .forces.pairwise import PARALLEL_MIN
 from .integrators import dormand_prince, euler, runge_kutta, splitting
 from .integrators.common import STEP_COLLAPSED, TIME_OVERFLOW
 from .space import check_box
-from .state import Model, State, Workspace
+from .state import INVALID_FIELDS, Model, State, Workspace
+from .state import first_invalid as first_invalid_in
 
 #: integrator families of the compiled batch step
 SPLITTING, EULER, RK4, RK45 = 0, 1, 2, 3
@@ -66,7 +66,7 @@ def system_model(model, m):
     return Model(model.kinds, model.params[m], model.param_offsets, model.indices, model.index_offsets)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def advance_system(m, t, h, steps, state, model, work, vdep, drifts, kicks):
     """``steps`` steps of a splitting scheme (``splitting.coefficients(name)``) on system m
     of a batch: the per-system kernel for compiled callers. Returns ``(t, h, done, status)``
@@ -124,35 +124,10 @@ def advance_all(family, t, h, steps, state, model, vdep, tol, drifts, kicks, don
 
 @njit(parallel=True, cache=True, error_model="numpy")
 def first_invalid(state, found):
-    """Bad input written into a batch's arrays, found before a step: ``found[m]`` is 0 when
-    system m is valid, else ``field * 2**32 + particle`` for its first invalid value (a
-    non-finite number, or a negative mass or radius; field 1 to 5 = pos, vel, mass, charge,
-    radius)."""
-    n = state.n
+    """``engine.state.first_invalid`` of every system into ``found`` (0 where valid), which
+    also sets pinned particles' velocities back to zero."""
     for m in prange(state.pos.shape[0]):
-        code = 0
-        for i in range(n):
-            if code:
-                break
-            for k in range(state.pos.shape[1]):
-                if not math.isfinite(state.pos[m, k, i]):
-                    code = 1 * 2 ** 32 + i
-                    break
-            if code:
-                break
-            for k in range(state.pos.shape[1]):
-                if not math.isfinite(state.vel[m, k, i]):
-                    code = 2 * 2 ** 32 + i
-                    break
-            if code:
-                break
-            if not (math.isfinite(state.mass[m, i]) and state.mass[m, i] >= 0.0):
-                code = 3 * 2 ** 32 + i
-            elif not math.isfinite(state.charge[m, i]):
-                code = 4 * 2 ** 32 + i
-            elif not (math.isfinite(state.radius[m, i]) and state.radius[m, i] >= 0.0):
-                code = 5 * 2 ** 32 + i
-        found[m] = code
+        found[m] = first_invalid_in(system_state(state, m))
 
 
 @njit(parallel=True, cache=True, error_model="numpy")
@@ -526,6 +501,13 @@ class Batch:
                 return int(self._model.param_offsets[k]) + start, shape
         raise ValueError(f"{term!r} was not packed before")
 
+    @property
+    def revision(self):
+        """A counter bumped by every change that re-packs the terms (a term or slots added or
+        removed, a term's parameter changed): ``kernel_arguments()`` and
+        ``parameter_columns()`` hold while it stays the same."""
+        return self._revision
+
     def kernel_arguments(self):
         """``(state, model)`` with the system axis: ``State`` arrays of shape (M, dim, capacity)
         and (M, capacity), ``Model.params`` of shape (M, F); for compiled code of your own."""
@@ -576,16 +558,12 @@ class Batch:
     def _check_state(self, state):
         """Refuse bad input written into the arrays (ValueError naming the field, system and
         particle; nothing changed); set pinned particles' velocities back to zero."""
-        n = self.n
-        pin = self._pinned[:, :n]
-        if pin.any():
-            self._vel[:, :, :n][np.broadcast_to(pin[:, None, :], (self.systems, self.dim, n))] = 0.0
         found = np.zeros(self.systems, dtype=np.int64)
         first_invalid(state, found)
         bad_systems = np.flatnonzero(found)
         if bad_systems.size:
             m = int(bad_systems[0])
-            field = ("pos", "vel", "mass", "charge", "radius")[int(found[m] >> 32) - 1]
+            field = INVALID_FIELDS[int(found[m] >> 32)]
             i = int(found[m] & 0xFFFFFFFF)
             value = {"pos": self._pos[m, :, i], "vel": self._vel[m, :, i]}.get(field)
             value = value.tolist() if value is not None else float(getattr(self, "_" + field)[m, i])

@@ -16,6 +16,7 @@ from .forces.base import Force
 from .forces.dispatch import pack, potential_terms
 from .particles import Particles
 from .space import check_box
+from .state import INVALID_FIELDS, first_invalid
 from .units import UnitSystem, strip_without_units
 
 _MAX_STEPS = MAX_STEPS
@@ -422,32 +423,21 @@ class Simulation:
         unchanged), never reported as a numerical blow-up of the step. A pinned particle's
         velocity written there is set back to zero (nothing moves it).
         """
-        pos, vel, n = state.pos, state.vel, state.n
-        pinned = state.pinned[:n]
-        if pinned.any():
-            vel[:, :n][:, pinned] = 0.0
-        if not (np.isfinite(pos[:, :n]).all() and np.isfinite(vel[:, :n]).all()):
-            broken = np.flatnonzero(~(np.isfinite(pos[:, :n]).all(0) & np.isfinite(vel[:, :n]).all(0)))
-            i = int(broken[0])
-            field = "pos" if not np.isfinite(pos[:, i]).all() else "vel"
+        code = first_invalid(state)
+        if not code:
+            return
+        field, i = INVALID_FIELDS[code >> 32], code & 0xFFFFFFFF
+        if field in ("pos", "vel"):
+            values = state.pos if field == "pos" else state.vel
             raise ValueError(f"particle {i} has a non-finite pos or vel: {field}[{i}] = "
-                             f"{(pos if field == 'pos' else vel)[:, i]} was written with a "
-                             "non-finite value (bad input); nothing was changed")
-        mass, charge, radius = state.mass, state.charge, state.radius
-        for field, arr, minimum in (("mass", mass, 0.0), ("charge", charge, None),
-                                    ("radius", radius, 0.0)):
-            values = arr[:n]
-            invalid = ~np.isfinite(values)
-            if minimum is not None:
-                invalid |= values < minimum
-            if invalid.any():
-                i = int(np.flatnonzero(invalid)[0])
-                rule = "finite" if minimum is None else f"finite and >= {minimum}"
-                hint = (" (to hold a particle still, pin it: sim.pin(i))"
-                        if field == "mass" and values[i] == math.inf else "")
-                raise ValueError(f"{field}[{i}] must be {rule}, got {float(values[i])!r} (written into "
-                                 f"sim.{field} directly: bad input, not a blow-up); nothing was "
-                                 f"changed{hint}")
+                             f"{values[:, i]} was written with a non-finite value (bad input); "
+                             "nothing was changed")
+        value = float(getattr(state, field)[i])
+        rule = "finite" if field == "charge" else "finite and >= 0.0"
+        hint = (" (to hold a particle still, pin it: sim.pin(i))"
+                if field == "mass" and value == math.inf else "")
+        raise ValueError(f"{field}[{i}] must be {rule}, got {value!r} (written into sim.{field} "
+                         f"directly: bad input, not a blow-up); nothing was changed{hint}")
 
     # -- diagnostics -----------------------------------------------------------------
     def _moving(self):

@@ -36,12 +36,19 @@ def nearest_image(d, side):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
+def period_shift(x, side, half):
+    """The whole periods ``side * floor(x / side + 1/2)`` that ``wrap`` takes off ``x``
+    (``side`` > 0; ``half`` is 1/2 in the precision of ``x``)."""
+    return side * np.floor(x / side + half)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
 def image(x, side, half):
     """``wrap`` for one number, inlined into compiled callers (the drift, the pair loops).
 
     ``half`` is 1/2 in the precision of ``x`` (a float32 pair loop stays in float32)."""
     if side > 0.0:
-        return x - side * np.floor(x / side + half)
+        return x - period_shift(x, side, half)
     return x
 
 
@@ -58,4 +65,4 @@ def check_box(box):
     return 0.0 if value is None else value
 
 
-__all__ = ["wrap", "nearest_image", "image", "wrap_scalar", "check_box"]
+__all__ = ["wrap", "nearest_image", "image", "period_shift", "wrap_scalar", "check_box"]

@@ -20,6 +20,7 @@ structs (fields read without reference counting in the ``_nrt=False`` kernels):
 With these, a force kernel is ``accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work)`` and
 an integrator step is ``advance(t, h, steps, state, model, work, vdep, t_end, ...)``.
 """
+import math
 from collections import namedtuple
 
 import numpy as np
@@ -45,4 +46,51 @@ def with_parameters(model, params):
     return Model(model.kinds, params, model.param_offsets, model.indices, model.index_offsets)
 
 
-__all__ = ["State", "Model", "Workspace", "EMPTY_WORKSPACE", "with_motion", "with_parameters"]
+#: fields ``first_invalid`` reports, by their code
+INVALID_FIELDS = ("", "pos", "vel", "mass", "charge", "radius")
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _bad_motion(a, i):
+    for k in range(a.shape[0]):
+        if not math.isfinite(a[k, i]):
+            return True
+    return False
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _bad(x, minimum):
+    return not (math.isfinite(x) and x >= minimum)
+
+
+@njit(cache=True, error_model="numpy")
+def first_invalid(state):
+    """Bad input written into a state's arrays, found in one compiled pass before a step:
+    0 when the state is valid, else ``field * 2**32 + particle`` (field as ``INVALID_FIELDS``)
+    for the first particle with a non-finite position or velocity, else the first with a bad
+    mass (non-finite or negative), charge (non-finite) or radius (non-finite or negative), in
+    that order. The velocities of pinned particles are set back to zero on the way."""
+    n = state.n
+    for i in range(n):
+        if state.pinned[i]:
+            for k in range(state.vel.shape[0]):
+                state.vel[k, i] = 0.0
+    for i in range(n):
+        if _bad_motion(state.pos, i):
+            return 1 * 2 ** 32 + i
+        if _bad_motion(state.vel, i):
+            return 2 * 2 ** 32 + i
+    for i in range(n):
+        if _bad(state.mass[i], 0.0):
+            return 3 * 2 ** 32 + i
+    for i in range(n):
+        if not math.isfinite(state.charge[i]):
+            return 4 * 2 ** 32 + i
+    for i in range(n):
+        if _bad(state.radius[i], 0.0):
+            return 5 * 2 ** 32 + i
+    return 0
+
+
+__all__ = ["State", "Model", "Workspace", "EMPTY_WORKSPACE", "with_motion", "with_parameters",
+           "first_invalid", "INVALID_FIELDS"]

@@ -21,7 +21,7 @@ from engine import space
 from engine.batch import advance_system
 from engine.cache import compiler
 from engine.integrators import splitting
-from engine.state import Workspace
+from engine.state import Model, State, Workspace
 
 # -- layout of the state arrays ---------------------------------------------------------
 # ship gauges, floats (M, 2, SF): heading, turn rate, fuel
@@ -349,13 +349,20 @@ def step_match(m, actions, state, model, work, ship_gauges, ship_counters, torp_
 
 
 @jit()
-def step_all(actions, state, model, ship_gauges, ship_counters, torp_life, match_state, rng,
-             rules, drifts, kicks):
-    """Advance every match by one frame (matches already over are left as they are)."""
+def step_all(actions, pos, vel, mass, charge, radius, active, test, pinned, n, box, kinds,
+             params, param_offsets, indices, index_offsets, ship_gauges, ship_counters,
+             torp_life, match_state, rng, rules, drifts, kicks):
+    """Advance every match by one frame (matches already over are left as they are).
+
+    The batch's ``State`` and ``Model`` come in as their arrays (numba reads plain array
+    arguments faster than named tuples of them at the call from Python) and are put together
+    here once."""
+    state = State(pos, vel, mass, charge, radius, active, test, pinned, n, box)
+    model = Model(kinds, params, param_offsets, indices, index_offsets)
     # the game's pair forces run the engine's scalar pair loop (no large-N workspace), as the
     # recorded replays were played
     work = Workspace(np.empty(0), np.empty(0, dtype=np.int64), False)
-    for m in range(state.pos.shape[0]):
+    for m in range(pos.shape[0]):
         step_match(m, actions, state, model, work, ship_gauges, ship_counters, torp_life,
                    match_state, rng, rules, drifts, kicks)
 

@@ -34,7 +34,7 @@ def force_terms(rules):
         terms.append(forces.NBodyGravity(G=rules.ship_gravity, softening=rules.hit_box))
     if rules.mode == "electric":
         terms.append(forces.Coulomb(k=rules.coulomb_k, softening=rules.hit_box))
-    terms.append(forces.Thrust())
+    terms.append(forces.Thrust(particles=ship_indices))  # the engines push the ships only
     return terms
 
 
@@ -115,6 +115,7 @@ class Game:
         thrust = self.terms[-1]
         thrust_columns = batch.parameter_columns(thrust, "force")  # written by the rules each frame
         self.state, self.model = batch.kernel_arguments()
+        self._revision = batch.revision
         self.rules_vector = _rules_vector(rules, self.rounds, thrust_columns[0])
         self.drifts, self.kicks = core.drift_kick()
         # the game's own state, beside the engine's
@@ -131,11 +132,12 @@ class Game:
         """Follow a re-pack of the batch (a term's attribute changed, a term or slots added):
         its parameter rows are then a new array, with the thrust at new columns, and the frame
         must write into and step with those, never a stale copy."""
-        state, model = self.batch.kernel_arguments()
-        if model is not self.model or state.pos is not self.state.pos or state.n != self.state.n:
-            self.state, self.model = state, model
-            self.rules_vector[core.R_THRUST_OFF] = self.batch.parameter_columns(self.terms[-1],
-                                                                                "force")[0]
+        if self.batch.revision == self._revision:
+            return
+        self.state, self.model = self.batch.kernel_arguments()
+        self.rules_vector[core.R_THRUST_OFF] = self.batch.parameter_columns(self.terms[-1],
+                                                                            "force")[0]
+        self._revision = self.batch.revision
 
     # the engine's arrays of every match: (M, 2, bodies) positions and velocities, (M, bodies)
     # masses, charges and active flags (the batch's storage, which the compiled frame writes)
@@ -157,9 +159,9 @@ class Game:
         else:
             self._actions[:] = self._encode(actions)
         self._sync_with_batch()
-        core.step_all(self._actions, self.state, self.model, self.ship_gauges, self.ship_counters,
-                      self.torp_life, self.match_state, self.rng, self.rules_vector, self.drifts,
-                      self.kicks)
+        core.step_all(self._actions, *self.state, *self.model, self.ship_gauges,
+                      self.ship_counters, self.torp_life, self.match_state, self.rng,
+                      self.rules_vector, self.drifts, self.kicks)
 
     def _encode(self, actions):
         if isinstance(actions, np.ndarray) and actions.dtype.kind in "iu":
@@ -248,7 +250,7 @@ class Game:
         """Match m's force parameters as the state hash has always covered them, so replays
         recorded before the game ran on ``engine.Batch`` still verify: each term's packed
         floats, with the torus side in the pair terms' box entry (the batch's space now holds
-        it) and only the two ships' thrust (the torpedo slots' is always zero)."""
+        it)."""
         row = self.model.params[m]
         offsets = self.model.param_offsets
         parts = []
@@ -256,8 +258,6 @@ class Game:
             block = row[offsets[k]:offsets[k + 1]].copy()
             if isinstance(term, (forces.NBodyGravity, forces.Coulomb)):
                 block[term.layout(self.batch)["box"][0]] = self.batch.box
-            if isinstance(term, forces.Thrust):
-                block = block[:4]
             parts.append(block)
         return np.concatenate(parts)
 

@@ -52,8 +52,9 @@ class Force:
     #: True if the term has a potential that ``sim.potential_energy()`` sums.
     conservative = False
     #: the packed float parameters in order, as ``(name, shape)``; a shape entry is an int,
-    #: ``"dim"`` (the simulation's dimension), ``"slots"`` (its particle slots) or
-    #: ``"items"`` (``len(term)``: one per spring)
+    #: ``"dim"`` (the simulation's dimension), ``"slots"`` (its particle slots), ``"rows"``
+    #: (``term._rows(sim)``: a Thrust's pushed particles) or ``"items"`` (``len(term)``: one
+    #: per spring)
     LAYOUT = ()
     #: lower bounds of packed parameters, ``name -> (minimum, strict)``: what a value set per
     #: system (``Batch.set_parameter``) is checked against, as the term's own checks would
@@ -89,6 +90,8 @@ class Force:
         block, for ``sim`` (a Simulation or Batch): how callers read and write parameters by
         name (``Batch.set_parameter``, ``Simulation.parameter``)."""
         sizes = {"dim": sim.dim, "slots": sim.n}
+        if any("rows" in spec for _, spec in self.LAYOUT):
+            sizes["rows"] = self._rows(sim)
         out = {}
         offset = 0
         for name, spec in self.LAYOUT:
@@ -104,8 +107,12 @@ class Force:
         self._sim = sim
 
     def _touch(self):
-        """Mark parameters changed so the next step re-reads them (no stale forces)."""
+        """Mark parameters changed so the next step re-reads them (no stale forces): the
+        term's own version and its simulation's revision, which keys the packed model."""
         self._version += 1
+        sim = self.__dict__.get("_sim")
+        if sim is not None:
+            sim._revision += 1
 
     def __setattr__(self, name, value):
         if name.startswith("_") or isinstance(getattr(type(self), name, None), property):
@@ -132,6 +139,8 @@ class Force:
                 raise
         # the next step re-packs the parameters
         object.__setattr__(self, "_version", self.__dict__.get("_version", 0) + 1)
+        if sim is not None:
+            sim._revision += 1
 
     def __repr__(self):
         return f"{type(self).__name__}()"

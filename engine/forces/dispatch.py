@@ -25,8 +25,8 @@ from . import (blast, buoyancy, coulomb, drag, gravity, point_mass, springs, thr
 def accelerations(t, state, model, acc, work):
     """Overwrite ``acc[:, :n]`` with the total acceleration of every declared term at time t.
 
-    A pinned particle's acceleration is then set to zero: it still exerts its forces (they
-    were summed), but nothing moves it."""
+    A pinned particle gets its acceleration like any other (it exerts its forces and feels
+    theirs); the integrators hold it still by masking its kicks and drifts."""
     n = state.n
     for k in range(acc.shape[0]):
         for i in range(n):
@@ -62,11 +62,6 @@ def accelerations(t, state, model, acc, work):
             buoyancy.accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work)
         elif kind == blast.KIND:
             blast.accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work)
-    pinned = state.pinned
-    for i in range(n):
-        if pinned[i]:
-            for k in range(acc.shape[0]):
-                acc[k, i] = 0.0
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)

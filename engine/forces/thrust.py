@@ -8,7 +8,7 @@ from numba import njit
 
 from ._kernels import add_force
 from .base import Force, EMPTY_INTS
-from .._validate import vector
+from .._validate import index_array, vector
 
 KIND = 6
 
@@ -20,12 +20,14 @@ def accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work):
     active = state.active
     n = state.n
     dim = pos.shape[0]
-    count = min(n, (f1 - f0) // dim)
-    for i in range(count):
-        if not active[i]:
+    listed = i1 > i0  # row r acts on particle indices[i0 + r]; else row i on particle i
+    count = (i1 - i0) if listed else min(n, (f1 - f0) // dim)
+    for r in range(count):
+        i = indices[i0 + r] if listed else r
+        if i >= n or not active[i]:
             continue
-        f2 = params[f0 + i * dim + 2] if dim == 3 else 0.0
-        add_force(acc, i, dim, params[f0 + i * dim], params[f0 + i * dim + 1], f2, mass[i])
+        f2 = params[f0 + r * dim + 2] if dim == 3 else 0.0
+        add_force(acc, i, dim, params[f0 + r * dim], params[f0 + r * dim + 1], f2, mass[i])
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
@@ -34,44 +36,73 @@ def potential(t, state, params, f0, f1, indices, i0, i1):
 
 
 class Thrust(Force):
-    """Per-particle control forces; all zero until ``set``."""
+    """Per-particle control forces; all zero until ``set``.
+
+    ``particles``: the indices it may push (default: every particle slot). A game's engines
+    push only its ships: listing them keeps the term's parameters to one row per ship.
+    """
 
     KIND = KIND
-    LAYOUT = (("force", ("slots", "dim")),)
+    LAYOUT = (("force", ("rows", "dim")),)
 
-    def __init__(self):
+    def __init__(self, particles=None):
         super().__init__()
         self._f = np.zeros((0, 0))
+        if particles is None:
+            self.particles = EMPTY_INTS
+        else:
+            self.particles = index_array("particles", particles).reshape(-1)
+            if self.particles.size == 0:
+                raise ValueError("particles must list at least one index (None means all)")
+            if np.unique(self.particles).size != self.particles.size:
+                raise ValueError(f"particles must not repeat an index, got {self.particles.tolist()}")
+
+    def _rows(self, sim):
+        """Rows of the packed forces: one per listed particle, else one per particle slot."""
+        return self.particles.size if self.particles.size else sim.n
 
     def _dim(self):
         if self._sim is None:
             raise ValueError("add the Thrust to a simulation (sim.add_force) before setting it")
         return self._sim.dim
 
-    def _index(self, i):
+    def _row(self, i):
         n = self._sim.n
         if isinstance(i, bool) or not isinstance(i, (int, np.integer)) or not 0 <= i < n:
             raise ValueError(f"particle index must be an int in [0, {n}), got {i!r}")
+        if self.particles.size:
+            where = np.flatnonzero(self.particles == i)
+            if where.size == 0:
+                raise ValueError(f"particle {i} is not one this Thrust pushes "
+                                 f"(particles={self.particles.tolist()})")
+            return int(where[0])
         return int(i)
+
+    def _check(self, sim):
+        bad = (self.particles < 0) | (self.particles >= sim.n)
+        if np.any(bad):
+            k = int(np.flatnonzero(bad)[0])
+            raise ValueError(f"particles[{k}] = {self.particles[k]} is out of range "
+                             f"(the simulation has {sim.n} particles)")
 
     def set(self, i, force):
         """Set the force on particle ``i`` (a vector of the simulation's dimension)."""
         dim = self._dim()
-        i = self._index(i)
+        r = self._row(i)
         f = vector("force", force, dim)
-        if self._f.shape[0] <= i or self._f.shape[1] != dim:
-            grown = np.zeros((max(i + 1, 2 * self._f.shape[0]), dim))
+        if self._f.shape[0] <= r or self._f.shape[1] != dim:
+            grown = np.zeros((max(r + 1, 2 * self._f.shape[0]), dim))
             if self._f.shape[1] == dim:
                 grown[: self._f.shape[0]] = self._f
             self._f = grown
-        self._f[i] = f
+        self._f[r] = f
         self._touch()
 
     def get(self, i):
         """The force currently set on particle ``i``."""
         dim = self._dim()
-        i = self._index(i)
-        return self._f[i].copy() if i < self._f.shape[0] else np.zeros(dim)
+        r = self._row(i)
+        return self._f[r].copy() if r < self._f.shape[0] else np.zeros(dim)
 
     def clear(self):
         """Set every force to zero."""
@@ -79,12 +110,13 @@ class Thrust(Force):
         self._touch()
 
     def _pack(self, sim):
-        """One force per particle slot (zeros beyond those set): the layout's (slots, dim)."""
-        f = np.zeros((sim.n, sim.dim))
-        rows = min(sim.n, self._f.shape[0])
-        if rows and self._f.shape[1] == sim.dim:
-            f[:rows] = self._f[:rows]
-        return f.reshape(-1), EMPTY_INTS
+        """One force per row (zeros beyond those set): the layout's (rows, dim)."""
+        rows = self._rows(sim)
+        f = np.zeros((rows, sim.dim))
+        kept = min(rows, self._f.shape[0])
+        if kept and self._f.shape[1] == sim.dim:
+            f[:kept] = self._f[:kept]
+        return f.reshape(-1), self.particles.copy()
 
 
 #: the term this module implements (for ``engine.forces.registry``)

@@ -14,7 +14,7 @@ import math
 import numpy as np
 from numba import njit
 
-from ..space import wrap_scalar
+from ..space import period_shift, wrap_scalar
 
 OK = -1
 STEP_COLLAPSED = -2
@@ -28,10 +28,12 @@ def drift(pos, vel, mask, n, h, box):
     put); the moving ones are then wrapped onto the periodic space of side ``box`` (none when
     box is 0)."""
     if box > 0.0:
+        # wrapped without a branch: a parked particle's shift is multiplied by its mask of 0
+        # (and a moving one's by 1.0, exactly space.wrap), so the loop stays vectorised
         for k in range(pos.shape[0]):
             for i in range(n):
                 moved = pos[k, i] + (h * mask[i]) * vel[k, i]
-                pos[k, i] = wrap_scalar(moved, box) if mask[i] != 0.0 else moved
+                pos[k, i] = moved - period_shift(moved, box, 0.5) * mask[i]
         return
     for k in range(pos.shape[0]):
         for i in range(n):
@@ -49,11 +51,22 @@ def wrap_positions(pos, mask, n, box):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def kick(vel, acc, n, h):
-    """v <- v + h a (forces are zero on inactive particles, so they keep their velocity)."""
+def kick(vel, acc, mask, n, h):
+    """v <- v + h a, masked to 0 for pinned (and inactive) particles, so a pinned particle's
+    velocity stays zero whatever acts on it (h * 1.0 is h: the others' kicks are exact)."""
     for k in range(vel.shape[0]):
         for i in range(n):
-            vel[k, i] += h * acc[k, i]
+            vel[k, i] += (h * mask[i]) * acc[k, i]
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def hold_pinned(acc, pinned, n):
+    """Zero the accelerations of pinned particles (Runge-Kutta stages: a pinned particle's
+    stage velocity must stay zero, so that its stage positions do not move)."""
+    for i in range(n):
+        if pinned[i]:
+            for k in range(acc.shape[0]):
+                acc[k, i] = 0.0
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -64,7 +77,7 @@ def copy_state(src_pos, src_vel, dst_pos, dst_vel, n):
             dst_vel[k, i] = src_vel[k, i]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def active_mask(active, pinned, n):
     """1.0 for the particles that move (active and not pinned), else 0.0."""
     mask = np.empty(n)

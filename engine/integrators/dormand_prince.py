@@ -19,7 +19,7 @@ from numba import njit
 from ..forces.dispatch import accelerations
 from ..state import with_motion
 from .common import (OK, STEP_COLLAPSED, TIME_OVERFLOW, active_mask, first_nonfinite,
-                     first_nonfinite_array, wrap_positions)
+                     first_nonfinite_array, hold_pinned, wrap_positions)
 
 NAME = "rk45"
 ORDER = 5
@@ -92,6 +92,7 @@ def advance(t, h, steps, state, model, work, vdep, t_end, tol):
     has_end = not math.isnan(t_end)
     kx[0, :, :] = vel[:, :n]
     accelerations(t, state, model, kv[0], work)
+    hold_pinned(kv[0], state.pinned, n)
     done = 0
     rejected = False
     while done < steps:
@@ -110,6 +111,7 @@ def advance(t, h, steps, state, model, work, vdep, t_end, tol):
             _stage_state(pos, vel, kx, kv, s, h_try, n, sx, sv)
             kx[s, :, :] = sv
             accelerations(t + _C[s] * h_try, stage, model, kv[s], work)
+            hold_pinned(kv[s], state.pinned, n)
         # stage 7 state is the fifth-order solution (sx, sv)
         status = first_nonfinite(sx, sv, active, n)
         if status < 0:

@@ -33,7 +33,7 @@ from .common import OK
 BLOCK = 64
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def applies(state, model):
     """Is this call the fused case: one open-space gravity term, few bodies, none of them test
     particles or pinned?"""

@@ -10,7 +10,7 @@ from numba import njit
 
 from ..forces.dispatch import accelerations
 from ..state import with_motion
-from .common import OK, active_mask, all_finite, first_nonfinite, wrap_positions
+from .common import OK, active_mask, all_finite, first_nonfinite, hold_pinned, wrap_positions
 
 NAME = "rk4"
 ORDER = 4
@@ -50,12 +50,16 @@ def advance(t, h, steps, state, model, work, vdep, t_end):
     t0 = t
     for step in range(steps):
         accelerations(t, state, model, a1, work)
+        hold_pinned(a1, state.pinned, n)
         _stage(pos, vel, vel, a1, 0.5 * h, n, x2, v2)
         accelerations(t + 0.5 * h, s2, model, a2, work)
+        hold_pinned(a2, state.pinned, n)
         _stage(pos, vel, v2, a2, 0.5 * h, n, x3, v3)
         accelerations(t + 0.5 * h, s3, model, a3, work)
+        hold_pinned(a3, state.pinned, n)
         _stage(pos, vel, v3, a3, h, n, x4, v4)
         accelerations(t + h, s4, model, a4, work)
+        hold_pinned(a4, state.pinned, n)
         # write the update into x2/v2 first so a blow-up leaves pos/vel untouched
         for k in range(dim):
             for i in range(n):

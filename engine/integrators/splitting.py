@@ -98,7 +98,7 @@ def advance(t, h, steps, state, model, work, vdep, t_end, drifts, kicks):
                 if not fresh:
                     accelerations(t_pos, state, model, acc, work)
                     fresh = True
-                kick(vel, acc, n, kicks[s] * h)
+                kick(vel, acc, mask, n, kicks[s] * h)
                 if vdep:
                     fresh = False
         if not all_finite(pos, vel, n):

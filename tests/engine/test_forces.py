@@ -422,3 +422,21 @@ def test_a_removed_force_stops_acting_even_when_its_address_is_reused():
         sim.add_force(_forces.Drag(linear=5.0))
         sim.step()
         assert _np.allclose(sim.vel, [[0.5, 0.0]])
+
+
+def test_a_thrust_on_listed_particles_packs_one_row_each_and_pushes_only_them():
+    sim = Simulation(dim=2, integrator="symplectic_euler", dt=1.0)
+    sim.add_many(mass=2.0, pos=np.zeros((4, 2)))
+    thrust = sim.add_force(forces.Thrust(particles=[3, 1]))
+    thrust.set(1, (2.0, 0.0))
+    thrust.set(3, (0.0, 4.0))
+    np.testing.assert_array_equal(sim.parameter(thrust, "force"), [[0.0, 4.0], [2.0, 0.0]])
+    sim.step()
+    np.testing.assert_array_equal(sim.vel, [[0, 0], [1.0, 0], [0, 0], [0, 2.0]])
+    np.testing.assert_array_equal(thrust.get(3), (0.0, 4.0))
+    with pytest.raises(ValueError, match=r"particle 2 is not one this Thrust pushes \(particles=\[3, 1\]\)"):
+        thrust.set(2, (1.0, 0.0))
+    with pytest.raises(ValueError, match="particles must not repeat an index"):
+        forces.Thrust(particles=[1, 1])
+    with pytest.raises(ValueError, match=r"particles\[0\] = 9 is out of range"):
+        Simulation().add_force(forces.Thrust(particles=[9]))
