@@ -127,6 +127,7 @@ class Game:
         self._actions = np.full((m, 2), core.NOOP, dtype=np.int64)
         core.reset_all(self.pos, self.vel, self.mass, self.charge, self.active, self.ship_gauges,
                        self.ship_counters, self.torp_life, self.match_state, self.rules_vector)
+        self._frame_arguments = self._gather_frame_arguments()
 
     def _sync_with_batch(self):
         """Follow a re-pack of the batch (a term's attribute changed, a term or slots added):
@@ -138,6 +139,13 @@ class Game:
         self.rules_vector[core.R_THRUST_OFF] = self.batch.parameter_columns(self.terms[-1],
                                                                             "force")[0]
         self._revision = self.batch.revision
+        self._frame_arguments = self._gather_frame_arguments()
+
+    def _gather_frame_arguments(self):
+        """What the compiled frame takes after the actions, gathered once (and again after a
+        re-pack), not per frame."""
+        return (*self.state, *self.model, self.ship_gauges, self.ship_counters, self.torp_life,
+                self.match_state, self.rng, self.rules_vector, self.drifts, self.kicks)
 
     # the engine's arrays of every match: (M, 2, bodies) positions and velocities, (M, bodies)
     # masses, charges and active flags (the batch's storage, which the compiled frame writes)
@@ -159,9 +167,7 @@ class Game:
         else:
             self._actions[:] = self._encode(actions)
         self._sync_with_batch()
-        core.step_all(self._actions, *self.state, *self.model, self.ship_gauges,
-                      self.ship_counters, self.torp_life, self.match_state, self.rng,
-                      self.rules_vector, self.drifts, self.kicks)
+        core.step_all(self._actions, *self._frame_arguments)
 
     def _encode(self, actions):
         if isinstance(actions, np.ndarray) and actions.dtype.kind in "iu":
