@@ -38,7 +38,7 @@ from . import integrators as _integrators
 from ._validate import (finite_float, int_in_range, nonnegative_float, positive_float, real_array,
                         step_count)
 from .errors import SimulationError
-from .forces.base import Force
+from .forces.base import DeclaresTerms
 from .forces.dispatch import pack, potential_terms
 from .forces.pairwise import PARALLEL_MIN
 from .integrators import dormand_prince, euler, runge_kutta, splitting
@@ -151,7 +151,7 @@ def momenta(state, moving, out):
         out[m] = diagnostics.momentum(state.vel[m], state.mass[m], moving[m], state.n)
 
 
-class Batch:
+class Batch(DeclaresTerms):
     """M independent systems with the same force terms and particle slots (see the module).
 
     Parameters mirror ``Simulation``'s: ``systems`` (M >= 1), ``dim``, ``integrator``, ``dt``,
@@ -375,45 +375,14 @@ class Batch:
         return int(system)
 
     # -- forces ----------------------------------------------------------------------
-    @property
-    def forces(self):
-        return tuple(self._forces)
+    _owner = "batch"
 
-    def add_force(self, force):
-        """Declare a force term for every system; it acts from the next step. Returns it."""
-        if not isinstance(force, Force):
-            raise TypeError(f"force must be an engine.forces term, got {force!r}")
-        if any(f is force for f in self._forces):
-            raise ValueError(f"{force!r} is already declared in this batch")
-        force._attach(self)
-        self._forces.append(force)
-        self._revision += 1
-        return force
-
-    def remove_force(self, force):
-        for k, f in enumerate(self._forces):
-            if f is force:
-                del self._forces[k]
-                force._sim = None
-                self._per_system = [(t, name) for t, name in self._per_system if t is not force]
-                self._revision += 1
-                return
-        raise ValueError(f"{force!r} is not declared in this batch")
+    def _forgotten(self, force):
+        self._per_system = [(t, name) for t, name in self._per_system if t is not force]
 
     def _slot(self, term, name):
         """The ``slice`` of ``name`` in a system's parameter row, and its shape."""
-        self._current_model()
-        for k, f in enumerate(self._forces):
-            if f is term:
-                layout = self._layouts[k]
-                if name not in layout:
-                    raise ValueError(f"{type(term).__name__} has no parameter {name!r}; its "
-                                     f"parameters are {', '.join(layout)}")
-                start, shape = layout[name]
-                start += int(self._model.param_offsets[k])
-                size = int(np.prod(shape, dtype=np.int64))
-                return slice(start, start + size), shape
-        raise ValueError(f"{term!r} is not declared in this batch")
+        return self._term_slot(self._current_model(), term, name)
 
     def parameter(self, term, name):
         """The packed values of ``term``'s parameter ``name`` in every system, (M, *shape)

@@ -12,7 +12,7 @@ from . import diagnostics
 from . import integrators as _integrators
 from ._validate import MAX_STEPS, finite_float, nonnegative_float, positive_float, real_array, step_count
 from .errors import SimulationError
-from .forces.base import Force
+from .forces.base import DeclaresTerms
 from .forces.dispatch import pack, potential_terms
 from .particles import Particles
 from .space import check_box
@@ -25,7 +25,7 @@ _MAX_STEPS = MAX_STEPS
 MAX_CAPACITY = 2 ** 31  # initial room beyond this is a mistake, not a plan (16 GiB of positions)
 
 
-class Simulation:
+class Simulation(DeclaresTerms):
     """A set of particles moved by declared force terms with a chosen integrator.
 
     Parameters
@@ -285,30 +285,6 @@ class Simulation:
         self._particles.pinned[self._index(i)] = False
 
     # -- forces ----------------------------------------------------------------------
-    @property
-    def forces(self):
-        return tuple(self._forces)
-
-    def add_force(self, force):
-        """Declare a force term; it acts from the next step. Returns the term."""
-        if not isinstance(force, Force):
-            raise TypeError(f"force must be an engine.forces term, got {force!r}")
-        if any(f is force for f in self._forces):
-            raise ValueError(f"{force!r} is already declared in this simulation")
-        force._attach(self)
-        self._forces.append(force)
-        self._revision += 1
-        return force
-
-    def remove_force(self, force):
-        for k, f in enumerate(self._forces):
-            if f is force:
-                del self._forces[k]
-                force._sim = None
-                self._revision += 1
-                return
-        raise ValueError(f"{force!r} is not declared in this simulation")
-
     def _current_model(self):
         key = (self._G, self._revision) + tuple(f._version for f in self._forces)
         if key != self._model_key:
@@ -321,17 +297,8 @@ class Simulation:
         term's ``LAYOUT`` declares: ``sim.parameter(star, "pos")`` is the attractor's
         position), as the compiled kernels see them at the next step."""
         model = self._current_model()
-        for k, f in enumerate(self._forces):
-            if f is term:
-                layout = term.layout(self)
-                if name not in layout:
-                    raise ValueError(f"{type(term).__name__} has no parameter {name!r}; its "
-                                     f"parameters are {', '.join(layout)}")
-                start, shape = layout[name]
-                start += int(model.param_offsets[k])
-                size = int(np.prod(shape, dtype=np.int64))
-                return model.params[start:start + size].reshape(shape).copy()
-        raise ValueError(f"{term!r} is not declared in this simulation")
+        cols, shape = self._term_slot(model, term, name)
+        return model.params[cols].reshape(shape).copy()
 
     def kernel_arguments(self):
         """``(state, model)``: this simulation as the ``engine.state`` named tuples the compiled

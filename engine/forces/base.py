@@ -14,6 +14,8 @@ import functools
 
 import numpy as np
 
+from .._validate import index_array
+
 
 def _sealing(init):
     """Wrap a force's ``__init__`` so the instance is sealed once construction is over."""
@@ -144,6 +146,79 @@ class Force:
 
     def __repr__(self):
         return f"{type(self).__name__}()"
+
+
+class DeclaresTerms:
+    """What a Simulation and a Batch share about their force terms: declaring and removing
+    them, each change bumping the revision that keys the packed model."""
+
+    #: how the owner names itself in messages ("simulation", "batch")
+    _owner = "simulation"
+
+    @property
+    def forces(self):
+        return tuple(self._forces)
+
+    def add_force(self, force):
+        """Declare a force term; it acts from the next step. Returns the term."""
+        if not isinstance(force, Force):
+            raise TypeError(f"force must be an engine.forces term, got {force!r}")
+        if any(f is force for f in self._forces):
+            raise ValueError(f"{force!r} is already declared in this {self._owner}")
+        force._attach(self)
+        self._forces.append(force)
+        self._revision += 1
+        return force
+
+    def remove_force(self, force):
+        """Remove a declared term; it stops acting from the next step."""
+        for k, f in enumerate(self._forces):
+            if f is force:
+                del self._forces[k]
+                force._sim = None
+                self._forgotten(force)
+                self._revision += 1
+                return
+        raise ValueError(f"{force!r} is not declared in this {self._owner}")
+
+    def _forgotten(self, force):
+        """Called when ``force`` is removed (a batch drops its per-system values)."""
+
+    def _term_slot(self, model, term, name):
+        """``(slice, shape)`` of ``term``'s parameter ``name`` in the packed parameters."""
+        for k, f in enumerate(self._forces):
+            if f is term:
+                layout = term.layout(self)
+                if name not in layout:
+                    raise ValueError(f"{type(term).__name__} has no parameter {name!r}; its "
+                                     f"parameters are {', '.join(layout)}")
+                start, shape = layout[name]
+                start += int(model.param_offsets[k])
+                size = int(np.prod(shape, dtype=np.int64))
+                return slice(start, start + size), shape
+        raise ValueError(f"{term!r} is not declared in this {self._owner}")
+
+
+def particle_list(name, particles):
+    """Optional particle indices of a term: EMPTY_INTS for None (every particle), else a
+    non-empty 1-D int array without repeats."""
+    if particles is None:
+        return EMPTY_INTS
+    indices = index_array(name, particles).reshape(-1)
+    if indices.size == 0:
+        raise ValueError(f"{name} must list at least one index (None means all)")
+    if np.unique(indices).size != indices.size:
+        raise ValueError(f"{name} must not repeat an index, got {indices.tolist()}")
+    return indices
+
+
+def check_particles(name, indices, sim):
+    """Raise ValueError if an index of ``indices`` is out of ``sim``'s range."""
+    bad = (indices < 0) | (indices >= sim.n)
+    if np.any(bad):
+        k = int(np.flatnonzero(bad)[0])
+        raise ValueError(f"{name}[{k}] = {indices[k]} is out of range "
+                         f"(the simulation has {sim.n} particles)")
 
 
 def _read_only(value):

@@ -11,8 +11,8 @@ import math
 from numba import njit
 
 from ._kernels import nearest_image
-from .base import Force, EMPTY_INTS
-from .._validate import index_array, positive_float, nonnegative_float, vector
+from .base import Force, check_particles, particle_list
+from .._validate import positive_float, nonnegative_float, vector
 
 import numpy as np
 
@@ -93,12 +93,7 @@ class PointMass(Force):
         self._mu = positive_float("mu", mu)
         self._pos = vector("pos", pos)
         self.softening = nonnegative_float("softening", softening)
-        if particles is None:
-            self.particles = EMPTY_INTS
-        else:
-            self.particles = index_array("particles", particles).reshape(-1)
-            if self.particles.size == 0:
-                raise ValueError("particles must list at least one index (None means all)")
+        self.particles = particle_list("particles", particles)
 
     @property
     def mu(self):
@@ -123,11 +118,7 @@ class PointMass(Force):
         if self._pos.shape[0] != sim.dim:
             raise ValueError(f"PointMass pos must have length {sim.dim} (the simulation's dim), "
                              f"got {tuple(self._pos)}")
-        bad = (self.particles < 0) | (self.particles >= sim.n)
-        if np.any(bad):
-            k = int(np.flatnonzero(bad)[0])
-            raise ValueError(f"particles[{k}] = {self.particles[k]} is out of range "
-                             f"(the simulation has {sim.n} particles)")
+        check_particles("particles", self.particles, sim)
 
     def _pack(self, sim):
         return np.concatenate(([self._mu, self.softening ** 2], self._pos)), self.particles.copy()

@@ -7,8 +7,8 @@ import numpy as np
 from numba import njit
 
 from ._kernels import add_force
-from .base import Force, EMPTY_INTS
-from .._validate import index_array, vector
+from .base import Force, check_particles, particle_list
+from .._validate import vector
 
 KIND = 6
 
@@ -48,14 +48,7 @@ class Thrust(Force):
     def __init__(self, particles=None):
         super().__init__()
         self._f = np.zeros((0, 0))
-        if particles is None:
-            self.particles = EMPTY_INTS
-        else:
-            self.particles = index_array("particles", particles).reshape(-1)
-            if self.particles.size == 0:
-                raise ValueError("particles must list at least one index (None means all)")
-            if np.unique(self.particles).size != self.particles.size:
-                raise ValueError(f"particles must not repeat an index, got {self.particles.tolist()}")
+        self.particles = particle_list("particles", particles)
 
     def _rows(self, sim):
         """Rows of the packed forces: one per listed particle, else one per particle slot."""
@@ -79,11 +72,7 @@ class Thrust(Force):
         return int(i)
 
     def _check(self, sim):
-        bad = (self.particles < 0) | (self.particles >= sim.n)
-        if np.any(bad):
-            k = int(np.flatnonzero(bad)[0])
-            raise ValueError(f"particles[{k}] = {self.particles[k]} is out of range "
-                             f"(the simulation has {sim.n} particles)")
+        check_particles("particles", self.particles, sim)
 
     def set(self, i, force):
         """Set the force on particle ``i`` (a vector of the simulation's dimension)."""
