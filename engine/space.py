@@ -6,7 +6,9 @@ pair force (gravity, Coulomb) and the game's collisions take separations by the 
 jax-md's ``space.periodic(side)`` (one displacement and one shift function shared by every
 energy; Schoenholz & Cubuk, NeurIPS 2020) is the model.
 
-    wrap(x, L)           = x - L floor(x / L + 1/2)       in [-L/2, L/2)
+    wrap(x, L)           = x - L floor(x (1/L) + 1/2)     in [-L/2, L/2) (a point exactly on
+                                                          the edge may round to +L/2 when L
+                                                          is not a power of two)
     nearest_image(d, L)  = the same map applied to a separation d = x_j - x_i
 
 With ``L = 0`` (open space) both return their argument unchanged. ``wrap`` and
@@ -25,7 +27,7 @@ def wrap(x, side):
     For Python callers (bots, drawing); compiled callers inline ``image``/``wrap_scalar``,
     the same formula, bit for bit (a test holds them to it)."""
     if side > 0.0:
-        return x - side * np.floor(x / side + 0.5)
+        return x - side * np.floor(x * (1.0 / side) + 0.5)
     return x
 
 
@@ -37,9 +39,11 @@ def nearest_image(d, side):
 
 @njit(cache=True, error_model="numpy", inline="always")
 def period_shift(x, side, half):
-    """The whole periods ``side * floor(x / side + 1/2)`` that ``wrap`` takes off ``x``
-    (``side`` > 0; ``half`` is 1/2 in the precision of ``x``)."""
-    return side * np.floor(x / side + half)
+    """The whole periods ``side * floor(x * (1 / side) + 1/2)`` that ``wrap`` takes off ``x``
+    (``side`` > 0; ``half`` is 1/2 in the precision of ``x``). A multiplication by the
+    reciprocal, which a loop computes once, rather than a division per coordinate: four
+    times cheaper in the vectorised drift, and exact for a side that is a power of two."""
+    return side * np.floor(x * ((half + half) / side) + half)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
