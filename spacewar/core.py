@@ -247,11 +247,15 @@ def _hit(pos, m, a, b, box, diamond):
 
 
 @jit()
-def _collisions(m, pos, vel, active, ship_counters, torp_life, match_state, rules):
+def _collisions(m, pos, vel, active, ship_counters, torp_life, match_state, rules, doomed_rows):
+    """Torpedoes and ships that touch, and what the star captures; ``doomed_rows`` (M, bodies)
+    is scratch, so a frame allocates nothing."""
     n = pos.shape[2]
     box = rules[R_HITBOX]
     diamond = rules[R_DIAMOND]
-    doomed = np.zeros(n, dtype=np.bool_)
+    doomed = doomed_rows[m]
+    for b in range(n):
+        doomed[b] = False
     for a in range(n):
         if not active[m, a]:
             continue
@@ -314,7 +318,7 @@ def _round_logic(m, pos, vel, mass, charge, active, ship_gauges, ship_counters, 
 
 @jit()
 def step_match(m, actions, state, model, work, ship_gauges, ship_counters, torp_life,
-               match_state, rng, rules, drifts, kicks):
+               match_state, rng, rules, drifts, kicks, doomed):
     """Advance match ``m`` by one frame with ``actions[m, 0]`` and ``actions[m, 1]``.
 
     ``state`` and ``model`` are the match batch's ``engine.Batch.kernel_arguments()``."""
@@ -343,7 +347,7 @@ def step_match(m, actions, state, model, work, ship_gauges, ship_counters, torp_
             torp_life[m, k] -= 1
             if torp_life[m, k] == 0:
                 active[m, 2 + k] = False  # bursts harmlessly
-    _collisions(m, pos, vel, active, ship_counters, torp_life, match_state, rules)
+    _collisions(m, pos, vel, active, ship_counters, torp_life, match_state, rules, doomed)
     _round_logic(m, pos, vel, mass, charge, active, ship_gauges, ship_counters, torp_life,
                  match_state, rules)
 
@@ -351,7 +355,7 @@ def step_match(m, actions, state, model, work, ship_gauges, ship_counters, torp_
 @jit()
 def step_all(actions, pos, vel, mass, charge, radius, active, test, pinned, n, box, kinds,
              params, param_offsets, indices, index_offsets, ship_gauges, ship_counters,
-             torp_life, match_state, rng, rules, drifts, kicks):
+             torp_life, match_state, rng, rules, drifts, kicks, doomed):
     """Advance every match by one frame (matches already over are left as they are).
 
     The batch's ``State`` and ``Model`` come in as their arrays (numba reads plain array
@@ -364,15 +368,24 @@ def step_all(actions, pos, vel, mass, charge, radius, active, test, pinned, n, b
     work = Workspace(np.empty(0), np.empty(0, dtype=np.int64), False)
     for m in range(pos.shape[0]):
         step_match(m, actions, state, model, work, ship_gauges, ship_counters, torp_life,
-                   match_state, rng, rules, drifts, kicks)
+                   match_state, rng, rules, drifts, kicks, doomed)
+
+
+@jit()
+def reset_match(m, pos, vel, mass, charge, active, ship_gauges, ship_counters, torp_life,
+                match_state, rules):
+    """Match m back to its first frame (its random stream is the caller's to set)."""
+    for k in range(match_state.shape[1]):
+        match_state[m, k] = 0
+    reset_round(m, pos, vel, mass, charge, active, ship_gauges, ship_counters, torp_life,
+                match_state, rules)
 
 
 @jit()
 def reset_all(pos, vel, mass, charge, active, ship_gauges, ship_counters, torp_life, match_state, rules):
     for m in range(pos.shape[0]):
-        for k in range(match_state.shape[1]):
-            match_state[m, k] = 0
-        reset_round(m, pos, vel, mass, charge, active, ship_gauges, ship_counters, torp_life, match_state, rules)
+        reset_match(m, pos, vel, mass, charge, active, ship_gauges, ship_counters, torp_life,
+                    match_state, rules)
 
 
 @jit()

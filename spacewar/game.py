@@ -125,6 +125,7 @@ class Game:
         self.match_state = np.zeros((m, core.MI), dtype=np.int64)
         self.rng = np.array([seed_state(s) for s in seeds], dtype=np.uint64)
         self._actions = np.full((m, 2), core.NOOP, dtype=np.int64)
+        self._doomed = np.zeros((m, nb), dtype=np.bool_)  # the collisions' scratch
         core.reset_all(self.pos, self.vel, self.mass, self.charge, self.active, self.ship_gauges,
                        self.ship_counters, self.torp_life, self.match_state, self.rules_vector)
         self._frame_arguments = self._gather_frame_arguments()
@@ -145,7 +146,8 @@ class Game:
         """What the compiled frame takes after the actions, gathered once (and again after a
         re-pack), not per frame."""
         return (*self.state, *self.model, self.ship_gauges, self.ship_counters, self.torp_life,
-                self.match_state, self.rng, self.rules_vector, self.drifts, self.kicks)
+                self.match_state, self.rng, self.rules_vector, self.drifts, self.kicks,
+                self._doomed)
 
     # the engine's arrays of every match: (M, 2, bodies) positions and velocities, (M, bodies)
     # masses, charges and active flags (the batch's storage, which the compiled frame writes)
@@ -218,6 +220,34 @@ class Game:
         core.write_observation(int(m), int(seat), self.pos, self.vel, self.charge, self.active,
                                self.ship_gauges, self.ship_counters, self.torp_life, self.match_state, self.rules_vector, raw)
         return raw
+
+    def learning_observations(self, out=None):
+        """Every match's two seats as learning observations, (M, 2, D) float32, written by
+        compiled code into ``out`` if given (``spacewar.learning.learning_layout`` names the
+        D entries)."""
+        from . import learning
+
+        shape = (self.n_matches, 2, learning.learning_length(self.rules))
+        if out is None:
+            out = np.empty(shape, dtype=np.float32)
+        elif (not isinstance(out, np.ndarray) or out.dtype != np.float32 or out.shape != shape
+              or not out.flags.c_contiguous or not out.flags.writeable):
+            raise ValueError(f"out must be a writeable C-contiguous float32 array of shape {shape}, "
+                             f"got {type(out).__name__} {getattr(out, 'dtype', '')} "
+                             f"{getattr(out, 'shape', '')}")
+        if getattr(self, "_learning_scales", None) is None:
+            self._learning_scales = learning.learning_scales(self.rules, self.rounds)
+        learning.write_all_learning(self.pos, self.vel, self.charge, self.active,
+                                    self.ship_gauges, self.ship_counters, self.torp_life,
+                                    self.match_state, self.rules_vector, self._learning_scales, out)
+        return out
+
+    def learning_observation(self, m, seat):
+        """One seat's learning observation computed in NumPy from the observation a bot gets
+        (``raw_observation``): the reference for ``learning_observations``."""
+        from .learning import learning_vector
+
+        return learning_vector(self.raw_observation(m, seat), self.rules, self.rounds)
 
     def observe(self, m, seat):
         """The observation of match ``m`` from seat ``seat``'s side: a fresh object whose arrays

@@ -1,0 +1,325 @@
+"""Observations for learning code: egocentric, fixed-length, scaled to about [-1, 1], float32.
+
+``learning_layout(rules)`` names the entries; ``write_learning`` (numba) writes one match's
+two seats into rows of a preallocated ``(M, 2, D)`` float32 buffer inside compiled code, and
+``learning_vector(raw, rules)`` computes the same numbers in NumPy from a bot's raw observation
+(``Game.raw_observation``), the readable reference the tests hold the compiled writer to.
+
+Egocentric: the star, the enemy and every torpedo are given relative to the own ship, by the
+nearest image on the unit torus (``engine.space.nearest_image``), so a policy sees the same
+numbers wherever on the torus a situation happens. Directions are in the arena's axes (not
+rotated into the ship's heading; the heading is given as its cosine and sine). Scales:
+
+- positions relative to the own ship: d / 0.5 (the torus's half side), in [-1, 1);
+- velocities (own, and relative ones): v / (3 muzzle speeds), about [-1, 1] in play (a torpedo
+  fired at the ship closes at up to twice the muzzle speed plus the ships' own);
+- the rest as fractions of their rules' maxima (fuel, torpedoes, jumps, reload and recharge
+  frames, flip cool-down, torpedo life, round frames), flags as 0 or 1, the charge as its sign.
+
+The torpedo slots are fixed: the own ship's ``T`` first, then the enemy's ``T``, in firing order
+within a round, each with a presence flag; an empty slot is all zeros.
+"""
+import math
+
+import numpy as np
+
+from numba import prange
+
+from engine import space
+from engine.state import Model, State, Workspace
+
+from . import core
+from .protocol import raw_layout
+from .rules import Rules
+
+jit = core.jit
+
+HEADER = ("round_time_fraction", "rounds_fraction", "score_difference", "star_present",
+          "star_strength", "electric")
+OWN = ("vx", "vy", "cos_heading", "sin_heading", "turn_rate", "fuel_fraction",
+       "torpedo_fraction", "hyperspace_fraction", "alive", "in_hyperspace", "reload_fraction",
+       "recharge_fraction", "charge_sign", "flip_cooldown_fraction")
+STAR = ("star_dx", "star_dy")
+ENEMY = ("dx", "dy", "dvx", "dvy", "cos_heading", "sin_heading", "turn_rate", "fuel_fraction",
+         "torpedo_fraction", "hyperspace_fraction", "alive", "in_hyperspace", "charge_sign")
+TORPEDO = ("present", "dx", "dy", "dvx", "dvy", "ttl_fraction")
+
+#: where each part starts in a learning observation
+_OWN = len(HEADER)
+_STAR = _OWN + len(OWN)
+_ENEMY = _STAR + len(STAR)
+_TORPEDOES = _ENEMY + len(ENEMY)
+_NT = len(TORPEDO)
+
+
+def learning_length(rules):
+    """D, the length of a learning observation under these rules."""
+    return _TORPEDOES + 2 * rules.torpedoes * _NT
+
+
+def learning_layout(rules):
+    """Names of the learning observation's entries, in order (see the module's text)."""
+    names = list(HEADER) + [f"me.{f}" for f in OWN] + list(STAR)
+    names += [f"enemy.{f}" for f in ENEMY]
+    for owner in ("mine", "enemy"):
+        for k in range(rules.torpedoes):
+            names += [f"torpedo.{owner}{k}.{f}" for f in TORPEDO]
+    return names
+
+
+def learning_scales(rules, rounds):
+    """The numbers that scale the entries, as one float64 vector for the compiled writer."""
+    return np.array([
+        1.0 / max(rules.max_round_frames, 1),              # 0 round frames
+        1.0 / max(rounds, 1),                               # 1 rounds
+        1.0 / 0.5,                                          # 2 positions: half the torus side
+        1.0 / (3.0 * max(rules.muzzle_speed, 1e-300)),      # 3 velocities
+        1.0 / max(4.0 * rules.turn_rate, 1e-300),           # 4 turn rate (the game's limit)
+        1.0 / max(rules.fuel, 1e-300),                      # 5 fuel
+        1.0 / max(rules.torpedoes, 1),                      # 6 torpedoes
+        1.0 / max(rules.hyperspace_jumps, 1),               # 7 jumps
+        1.0 / max(rules.reload, 1),                         # 8 reload
+        1.0 / max(rules.hyperspace_recharge, 1),            # 9 recharge
+        1.0 / max(rules.flip_cooldown, 1),                  # 10 flip cool-down
+        1.0 / max(rules.torpedo_life, 1),                   # 11 torpedo life
+        1.0 / Rules().star_mu,                              # 12 star strength: heavy = 1
+        float(rules.mode == "electric"),                    # 13 electric mode
+    ])
+
+
+@jit(inline="always")
+def _sign(x):
+    return 1.0 if x > 0.0 else (-1.0 if x < 0.0 else 0.0)
+
+
+@jit()
+def write_learning(m, seat, pos, vel, charge, active, ship_gauges, ship_counters, torp_life,
+                   match_state, rules, scales, out):
+    """Match ``m`` seen from ``seat`` as a learning observation, into ``out`` (float32, D)."""
+    me = seat
+    en = 1 - seat
+    ntorp = int(rules[core.R_NTORP])
+    side = 1.0
+    sp = scales[2]
+    sv = scales[3]
+    x0 = pos[m, 0, me]
+    y0 = pos[m, 1, me]
+    vx0 = vel[m, 0, me]
+    vy0 = vel[m, 1, me]
+    # header
+    out[0] = match_state[m, core.ROUND_FRAME] * scales[0]
+    out[1] = match_state[m, core.ROUNDS_PLAYED] * scales[1]
+    out[2] = (match_state[m, core.SCORE0 + me] - match_state[m, core.SCORE0 + en]) * scales[1]
+    out[3] = 1.0 if rules[core.R_STAR] > 0.0 else 0.0
+    out[4] = rules[core.R_STAR] * scales[12]
+    out[5] = scales[13]
+    # the own ship
+    o = _OWN
+    h = ship_gauges[m, me, core.HEADING]
+    out[o] = vx0 * sv
+    out[o + 1] = vy0 * sv
+    out[o + 2] = math.cos(h)
+    out[o + 3] = math.sin(h)
+    out[o + 4] = ship_gauges[m, me, core.OMEGA] * scales[4]
+    out[o + 5] = ship_gauges[m, me, core.FUEL] * scales[5]
+    out[o + 6] = ship_counters[m, me, core.TORPS] * scales[6]
+    out[o + 7] = ship_counters[m, me, core.HYPER_LEFT] * scales[7]
+    out[o + 8] = ship_counters[m, me, core.ALIVE]
+    out[o + 9] = ship_counters[m, me, core.IN_HYPER]
+    out[o + 10] = ship_counters[m, me, core.RELOAD] * scales[8]
+    out[o + 11] = ship_counters[m, me, core.HYPER_RECHARGE] * scales[9]
+    out[o + 12] = _sign(charge[m, me])
+    out[o + 13] = ship_counters[m, me, core.FLIP_CD] * scales[10]
+    # the star at the origin, relative to the own ship
+    out[_STAR] = space.wrap_scalar(0.0 - x0, side) * sp
+    out[_STAR + 1] = space.wrap_scalar(0.0 - y0, side) * sp
+    # the enemy
+    e = _ENEMY
+    he = ship_gauges[m, en, core.HEADING]
+    out[e] = space.wrap_scalar(pos[m, 0, en] - x0, side) * sp
+    out[e + 1] = space.wrap_scalar(pos[m, 1, en] - y0, side) * sp
+    out[e + 2] = (vel[m, 0, en] - vx0) * sv
+    out[e + 3] = (vel[m, 1, en] - vy0) * sv
+    out[e + 4] = math.cos(he)
+    out[e + 5] = math.sin(he)
+    out[e + 6] = ship_gauges[m, en, core.OMEGA] * scales[4]
+    out[e + 7] = ship_gauges[m, en, core.FUEL] * scales[5]
+    out[e + 8] = ship_counters[m, en, core.TORPS] * scales[6]
+    out[e + 9] = ship_counters[m, en, core.HYPER_LEFT] * scales[7]
+    out[e + 10] = ship_counters[m, en, core.ALIVE]
+    out[e + 11] = ship_counters[m, en, core.IN_HYPER]
+    out[e + 12] = _sign(charge[m, en])
+    # the torpedo slots, own first
+    o = _TORPEDOES
+    for row in range(2):
+        owner = me if row == 0 else en
+        for k in range(ntorp):
+            b = 2 + owner * ntorp + k
+            if active[m, b]:
+                out[o] = 1.0
+                out[o + 1] = space.wrap_scalar(pos[m, 0, b] - x0, side) * sp
+                out[o + 2] = space.wrap_scalar(pos[m, 1, b] - y0, side) * sp
+                out[o + 3] = (vel[m, 0, b] - vx0) * sv
+                out[o + 4] = (vel[m, 1, b] - vy0) * sv
+                out[o + 5] = torp_life[m, owner * ntorp + k] * scales[11]
+            else:
+                for j in range(_NT):
+                    out[o + j] = 0.0
+            o += _NT
+
+
+@jit(parallel=False)
+def write_all_learning(pos, vel, charge, active, ship_gauges, ship_counters, torp_life,
+                       match_state, rules, scales, out):
+    """Every match's two seats into ``out`` (M, 2, D) float32."""
+    for m in range(pos.shape[0]):
+        for seat in range(2):
+            write_learning(m, seat, pos, vel, charge, active, ship_gauges, ship_counters,
+                           torp_life, match_state, rules, scales, out[m, seat])
+
+
+_EPISODE_MIX = np.uint64(0xD1B54A32D192ED03)
+_MATCH_MIX = np.uint64(0x9E3779B97F4A7C15)
+
+
+@jit()
+def episode_stream(base, m, episode):
+    """The random-stream state of match ``m``'s episode ``episode`` under a base seed state:
+    a function of the three alone, so a run is the same whatever the batch size or thread
+    count (splitmix64's finaliser over the mixed words; Steele, Lea & Flood 2014)."""
+    z = base ^ (np.uint64(m) * _MATCH_MIX) ^ (np.uint64(episode) * _EPISODE_MIX)
+    z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
+    z = (z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
+    return z ^ (z >> np.uint64(31))
+
+
+@jit(parallel=True)
+def step_learning(actions, pos, vel, mass, charge, radius, active, test, pinned, n, box, kinds,
+                  params, param_offsets, indices, index_offsets, ship_gauges, ship_counters,
+                  torp_life, match_state, rng, rules, drifts, kicks, doomed, scales, base,
+                  episodes, frame_cap, pending, observations, rewards, terminated, truncated):
+    """One step of every match for learning code, matches spread over the threads.
+
+    A match whose episode ended at the previous call (``pending[m]``) is reset instead, with
+    the stream ``episode_stream(base, m, episodes[m])`` (Gymnasium's next-step autoreset):
+    its reward is 0 and its new first observation is written. Otherwise it plays a frame with
+    ``actions[m]``; ``rewards[m, seat]`` is +1 when the frame scored a round for the seat and
+    not for the enemy, -1 the other way, 0 otherwise; ``terminated[m]`` at the match's end,
+    ``truncated[m]`` at ``frame_cap`` frames (0: none). Every match's two seats are then
+    written into ``observations`` (M, 2, D) float32. Nothing is allocated per match."""
+    state = State(pos, vel, mass, charge, radius, active, test, pinned, n, box)
+    model = Model(kinds, params, param_offsets, indices, index_offsets)
+    work = Workspace(np.empty(0), np.empty(0, dtype=np.int64), False)
+    for m in prange(pos.shape[0]):
+        rewards[m, 0] = 0.0
+        rewards[m, 1] = 0.0
+        terminated[m] = False
+        truncated[m] = False
+        if pending[m]:
+            episodes[m] += 1
+            rng[m] = episode_stream(base, m, episodes[m])
+            core.reset_match(m, pos, vel, mass, charge, active, ship_gauges, ship_counters,
+                             torp_life, match_state, rules)
+            pending[m] = False
+        else:
+            s0 = match_state[m, core.SCORE0]
+            s1 = match_state[m, core.SCORE1]
+            core.step_match(m, actions, state, model, work, ship_gauges, ship_counters, torp_life,
+                            match_state, rng, rules, drifts, kicks, doomed)
+            d0 = match_state[m, core.SCORE0] - s0
+            d1 = match_state[m, core.SCORE1] - s1
+            if d0 > 0 and d1 == 0:
+                rewards[m, 0] = 1.0
+                rewards[m, 1] = -1.0
+            elif d1 > 0 and d0 == 0:
+                rewards[m, 0] = -1.0
+                rewards[m, 1] = 1.0
+            if match_state[m, core.OVER] == 1:
+                terminated[m] = True
+            elif frame_cap > 0 and match_state[m, core.FRAME] >= frame_cap:
+                truncated[m] = True
+            pending[m] = terminated[m] or truncated[m]
+        for seat in range(2):
+            write_learning(m, seat, pos, vel, charge, active, ship_gauges, ship_counters,
+                           torp_life, match_state, rules, scales, observations[m, seat])
+
+
+class LearningBatch:
+    """M matches stepped for learning code: (M, 2) actions in; (M, 2, D) float32 observations,
+    (M, 2) rewards and (M,) terminated and truncated flags out, from one compiled call.
+
+    Episodes restart themselves at the call after they end (Gymnasium's next-step autoreset),
+    match m's episode e playing the stream ``episode_stream(seed state, m, e)``: a run is
+    reproducible whatever the batch size or thread count. ``frame_cap`` truncates an episode
+    after that many frames (0: only the match's end ends it)."""
+
+    def __init__(self, matches, rules=None, seed=0, rounds=3, frame_cap=0):
+        from .game import Game, seed_state
+
+        if isinstance(frame_cap, bool) or not isinstance(frame_cap, (int, np.integer)) \
+                or frame_cap < 0:
+            raise ValueError(f"frame_cap must be an int >= 0, got {frame_cap!r}")
+        self.game = Game(rules, seeds=[0] * int(matches) if matches else [], rounds=rounds)
+        self.rules = self.game.rules
+        self.frame_cap = int(frame_cap)
+        self.base = seed_state(seed)
+        self.episodes = np.full(self.game.n_matches, -1, dtype=np.int64)
+        self.pending = np.ones(self.game.n_matches, dtype=np.bool_)  # the first call resets
+        self.scales = learning_scales(self.rules, rounds)
+        self.observations = np.zeros((self.game.n_matches, 2, learning_length(self.rules)),
+                                     dtype=np.float32)
+        self.rewards = np.zeros((self.game.n_matches, 2), dtype=np.float32)
+        self.terminated = np.zeros(self.game.n_matches, dtype=np.bool_)
+        self.truncated = np.zeros(self.game.n_matches, dtype=np.bool_)
+
+    def step(self, actions):
+        """One step of every match (a reset for those whose episode ended last call)."""
+        game = self.game
+        codes = game._encode(actions)
+        game._sync_with_batch()
+        step_learning(codes, *game._frame_arguments, self.scales, self.base, self.episodes,
+                      self.frame_cap, self.pending, self.observations, self.rewards,
+                      self.terminated, self.truncated)
+        return self.observations, self.rewards, self.terminated, self.truncated
+
+
+def learning_vector(raw, rules, rounds):
+    """The learning observation of one seat from its raw observation (``Game.raw_observation``),
+    in NumPy: the readable definition the compiled writer follows, float32."""
+    names = raw_layout(rules)
+    r = dict(zip(names, np.asarray(raw, dtype=np.float64).tolist()))
+    s = learning_scales(rules, rounds)
+    sp, sv = s[2], s[3]
+
+    def rel(x):
+        return float(space.nearest_image(x, 1.0)) * sp
+
+    def sign(x):
+        return float(np.sign(x))
+
+    x0, y0, vx0, vy0 = r["me.x"], r["me.y"], r["me.vx"], r["me.vy"]
+    out = [r["round_frame"] * s[0], r["round"] * s[1], (r["score_me"] - r["score_enemy"]) * s[1],
+           1.0 if r["star_mu"] > 0.0 else 0.0, r["star_mu"] * s[12], s[13]]
+    out += [vx0 * sv, vy0 * sv, math.cos(r["me.heading"]), math.sin(r["me.heading"]),
+            r["me.angular_velocity"] * s[4], r["me.fuel"] * s[5], r["me.torpedoes"] * s[6],
+            r["me.hyperspace"] * s[7], r["me.alive"], r["me.in_hyperspace"], r["me.reload"] * s[8],
+            r["me.hyperspace_recharge"] * s[9], sign(r["me.charge"]), r["me.flip_cooldown"] * s[10]]
+    out += [rel(0.0 - x0), rel(0.0 - y0)]
+    out += [rel(r["enemy.x"] - x0), rel(r["enemy.y"] - y0), (r["enemy.vx"] - vx0) * sv,
+            (r["enemy.vy"] - vy0) * sv, math.cos(r["enemy.heading"]), math.sin(r["enemy.heading"]),
+            r["enemy.angular_velocity"] * s[4], r["enemy.fuel"] * s[5], r["enemy.torpedoes"] * s[6],
+            r["enemy.hyperspace"] * s[7], r["enemy.alive"], r["enemy.in_hyperspace"],
+            sign(r["enemy.charge"])]
+    for k in range(2 * rules.torpedoes):
+        t = {f: r[f"torpedo{k}.{f}"] for f in ("present", "x", "y", "vx", "vy", "ttl")}
+        if t["present"]:
+            out += [1.0, rel(t["x"] - x0), rel(t["y"] - y0), (t["vx"] - vx0) * sv,
+                    (t["vy"] - vy0) * sv, t["ttl"] * s[11]]
+        else:
+            out += [0.0] * _NT
+    return np.array(out, dtype=np.float32)
+
+
+__all__ = ["learning_layout", "learning_length", "learning_scales", "learning_vector",
+           "write_learning", "write_all_learning", "episode_stream", "step_learning",
+           "LearningBatch"]
