@@ -15,7 +15,9 @@ of the ratios is reported (with the median times). Sections:
 6. headless Spacewar: frames per second of one match with built-in bots, and of many
    matches advanced together;
 7. ``engine.Batch``: 4096 systems of the game's size advanced by one call, against one
-   ``Simulation.step`` call per system, at 1 thread and at every thread.
+   ``Simulation.step`` call per system, at 1 thread and at every thread;
+8. ``spacewar.learning.LearningBatch``: 4096 matches stepped with observations and rewards,
+   at 1 thread and at every thread.
 """
 import argparse
 import json
@@ -451,6 +453,37 @@ def bench_batch(systems=4096, slots=66, repeats=5):
             "bit_identical_to_separate": bool(same)}
 
 
+# -- 8. Spacewar for learning code: spacewar.learning.LearningBatch ---------------------------
+def bench_learning(matches=4096, frames=50, repeats=3):
+    """Match-frames per second of ``LearningBatch.step`` (random actions; observations,
+    rewards, terminations and resets included), at 1 thread and at every thread, with the
+    results compared between the two."""
+    import numba
+
+    from spacewar.learning import LearningBatch
+
+    codes = np.random.default_rng(0).integers(0, 24, size=(frames, matches, 2))
+    rows, finals = {}, []
+    threads = numba.get_num_threads()
+    try:
+        for count in sorted({1, numba.config.NUMBA_NUM_THREADS}):
+            numba.set_num_threads(count)
+            batch = LearningBatch(matches, seed=1, rounds=3, frame_cap=3000)
+            batch.step(codes[0])
+            best = math.inf
+            for _ in range(repeats):
+                start = time.perf_counter()
+                for f in range(frames):
+                    batch.step(codes[f])
+                best = min(best, time.perf_counter() - start)
+            rows[str(count)] = {"match_frames_per_second": matches * frames / best}
+            finals.append(batch.observations.copy())
+    finally:
+        numba.set_num_threads(threads)
+    same = all(np.array_equal(finals[0], other) for other in finals[1:])
+    return {"matches": matches, "threads": rows, "identical_across_threads": bool(same)}
+
+
 # -- the machine --------------------------------------------------------------------------------
 def machine():
     import numba
@@ -483,7 +516,8 @@ def machine():
 
 
 def run(quick=False, sections=None):
-    sections = sections or ["direct", "small", "scaling", "terms", "startup", "spacewar", "batch"]
+    sections = sections or ["direct", "small", "scaling", "terms", "startup", "spacewar", "batch",
+                            "learning"]
     repeats = 3 if quick else 7
     report = {"machine": machine(), "quick": quick}
     if "direct" in sections:
@@ -500,6 +534,8 @@ def run(quick=False, sections=None):
         report["spacewar"] = bench_spacewar(64 if quick else 256, 500 if quick else 2000)
     if "batch" in sections:
         report["batch"] = bench_batch(1024 if quick else 4096, repeats=3 if quick else 5)
+    if "learning" in sections:
+        report["learning"] = bench_learning(1024 if quick else 4096)
     return report
 
 
@@ -647,6 +683,13 @@ def format_report(r):
             lines.append(f"  {count} thread(s): batch {row['batch_systems_per_second']:.3e} "
                          f"system-steps/s; separate Simulation.step calls "
                          f"{row['separate_simulations_per_second']:.3e}; {row['speedup']:.1f}x")
+    if "learning" in r:
+        g = r["learning"]
+        same = "identical" if g["identical_across_threads"] else "DIFFERENT"
+        lines.append(f"\n8. learning batch: {g['matches']} matches, observations and rewards included "
+                     f"({same} at every thread count): " + "; ".join(
+                         f"{count} thread(s) {row['match_frames_per_second']:.3e} match-frames/s"
+                         for count, row in g["threads"].items()))
     if targets(r):
         lines.append("\ntargets:")
         for name, measured, met in targets(r):
@@ -748,6 +791,17 @@ def format_markdown(r, command):
                 f"{row['separate_simulations_per_second']:.3e} | {row['speedup']:.1f}x |"
                 for count, row in b["threads"].items()]
         out.append("")
+    if "learning" in r:
+        g = r["learning"]
+        out += [f"## 8. Spacewar for learning code (`spacewar.learning.LearningBatch`, "
+                f"{g['matches']} matches)", "",
+                "Random actions; every match's two egocentric observations, rewards, "
+                "terminations and resets included in the compiled step. Results "
+                + ("identical" if g["identical_across_threads"] else "**different**")
+                + " at every thread count.", "", "| threads | match-frames/s |", "|---|---|"]
+        out += [f"| {count} | {row['match_frames_per_second']:.3e} |"
+                for count, row in g["threads"].items()]
+        out.append("")
     return "\n".join(out)
 
 
@@ -758,7 +812,7 @@ def main(argv=None):
     parser.add_argument("--json", metavar="FILE", help="also write the results as JSON")
     parser.add_argument("--markdown", metavar="FILE", help="also write the results as Markdown")
     parser.add_argument("--only", metavar="SECTIONS",
-                        help="comma-separated: direct,small,scaling,terms,startup,spacewar,batch")
+                        help="comma-separated: direct,small,scaling,terms,startup,spacewar,batch,learning")
     args = parser.parse_args(argv)
     # a bad output path fails now, not after minutes of benchmarks
     try:
