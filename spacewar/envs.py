@@ -190,7 +190,66 @@ class SpacewarEnv(gymnasium.Env):
         return obs[0], float(rewards[0]), bool(terminated[0]), bool(truncated[0]), info
 
 
+AGENTS = ("ship_0", "ship_1")
+
+
+def parallel_env(rules=None, rounds=3, max_frames=20000, render_mode=None):
+    """One match with both seats as agents, a PettingZoo ``ParallelEnv`` (``pip install -e
+    '.[rl]'``): agents ``"ship_0"`` and ``"ship_1"``, the spaces, rewards and episode end of
+    the Gymnasium environments; both agents leave when the match ends."""
+    try:
+        from pettingzoo import ParallelEnv
+    except ImportError as error:  # pragma: no cover - the extra is missing
+        raise ImportError("spacewar.envs.parallel_env needs PettingZoo: pip install -e '.[rl]'") \
+            from error
+
+    class SpacewarParallelEnv(ParallelEnv):
+        metadata = {"name": "spacewar_v0", "render_modes": []}
+
+        def __init__(self):
+            self._vector = SpacewarVectorEnv(2, opponent=None, rules=rules, rounds=rounds,
+                                             max_frames=max_frames, render_mode=render_mode)
+            self.render_mode = None
+            self.possible_agents = list(AGENTS)
+            self.agents = []
+            self._spaces = (self._vector.single_observation_space,
+                            self._vector.single_action_space)
+
+        def observation_space(self, agent):
+            return self._spaces[0]
+
+        def action_space(self, agent):
+            return self._spaces[1]
+
+        def reset(self, seed=None, options=None):
+            obs, _ = self._vector.reset(seed=seed, options=options)
+            self.agents = list(AGENTS)
+            return {a: obs[k] for k, a in enumerate(AGENTS)}, {a: {} for a in AGENTS}
+
+        def step(self, actions):
+            if not self.agents:
+                raise RuntimeError("the match has ended: call reset()")
+            missing = [a for a in AGENTS if a not in actions]
+            if missing:
+                raise ValueError(f"actions must hold one action per agent, missing {missing}")
+            parts = np.array([actions[a] for a in AGENTS], dtype=np.int64)
+            obs, rewards, terminated, truncated, _ = self._vector.step(parts)
+            out = ({a: obs[k] for k, a in enumerate(AGENTS)},
+                   {a: float(rewards[k]) for k, a in enumerate(AGENTS)},
+                   {a: bool(terminated[k]) for k, a in enumerate(AGENTS)},
+                   {a: bool(truncated[k]) for k, a in enumerate(AGENTS)},
+                   {a: {} for a in AGENTS})
+            if terminated[0] or truncated[0]:
+                self.agents = []
+            return out
+
+        def close(self):
+            pass
+
+    return SpacewarParallelEnv()
+
+
 gymnasium.register("Spacewar-v0", entry_point=SpacewarEnv, vector_entry_point=SpacewarVectorEnv)
 
-__all__ = ["SpacewarEnv", "SpacewarVectorEnv", "action_space", "observation_space",
-           "codes_from_parts", "learning_length"]
+__all__ = ["SpacewarEnv", "SpacewarVectorEnv", "parallel_env", "AGENTS", "action_space",
+           "observation_space", "codes_from_parts", "learning_length"]

@@ -69,3 +69,27 @@ def test_bad_arguments_are_refused():
     with pytest.raises(ValueError, match="actions must be 2 MultiDiscrete"):
         vec.step(np.full((2, 4), 5))
     np.testing.assert_array_equal(envs.codes_from_parts([[2, 1, 1, 0]]), [2 + 3 + 6])
+
+
+def test_the_parallel_env_passes_pettingzoos_api_and_seed_tests():
+    pytest.importorskip("pettingzoo")
+    from pettingzoo.test import parallel_api_test, parallel_seed_test
+
+    parallel_api_test(envs.parallel_env(max_frames=400), num_cycles=500)
+    parallel_seed_test(lambda: envs.parallel_env(max_frames=400), num_cycles=300)
+
+
+def test_the_parallel_env_is_a_zero_sum_match_that_ends_for_both():
+    pytest.importorskip("pettingzoo")
+    env = envs.parallel_env(max_frames=600)
+    obs, infos = env.reset(seed=4)
+    assert set(obs) == set(envs.AGENTS)
+    totals = dict.fromkeys(envs.AGENTS, 0.0)
+    while env.agents:
+        obs, rewards, terms, truncs, infos = env.step(
+            {a: env.action_space(a).sample() for a in env.agents})
+        for a, r in rewards.items():
+            totals[a] += r
+    assert totals["ship_0"] == -totals["ship_1"] and (any(terms.values()) or any(truncs.values()))
+    with pytest.raises(RuntimeError, match="the match has ended"):
+        env.step({a: np.zeros(4, dtype=np.int64) for a in envs.AGENTS})
