@@ -92,6 +92,21 @@ def _sign(x):
     return 1.0 if x > 0.0 else (-1.0 if x < 0.0 else 0.0)
 
 
+@jit(inline="always")
+def _write_gauges(out, o, m, s, ship_gauges, ship_counters, scales):
+    """Ship s's heading (cos, sin), turn rate, fuel, torpedoes, jumps and flags from out[o]:
+    the eight entries the own ship and the enemy share."""
+    h = ship_gauges[m, s, core.HEADING]
+    out[o] = math.cos(h)
+    out[o + 1] = math.sin(h)
+    out[o + 2] = ship_gauges[m, s, core.OMEGA] * scales[4]
+    out[o + 3] = ship_gauges[m, s, core.FUEL] * scales[5]
+    out[o + 4] = ship_counters[m, s, core.TORPS] * scales[6]
+    out[o + 5] = ship_counters[m, s, core.HYPER_LEFT] * scales[7]
+    out[o + 6] = ship_counters[m, s, core.ALIVE]
+    out[o + 7] = ship_counters[m, s, core.IN_HYPER]
+
+
 @jit()
 def write_learning(m, seat, pos, vel, charge, active, ship_gauges, ship_counters, torp_life,
                    match_state, rules, scales, out):
@@ -115,17 +130,9 @@ def write_learning(m, seat, pos, vel, charge, active, ship_gauges, ship_counters
     out[5] = scales[13]
     # the own ship
     o = _OWN
-    h = ship_gauges[m, me, core.HEADING]
     out[o] = vx0 * sv
     out[o + 1] = vy0 * sv
-    out[o + 2] = math.cos(h)
-    out[o + 3] = math.sin(h)
-    out[o + 4] = ship_gauges[m, me, core.OMEGA] * scales[4]
-    out[o + 5] = ship_gauges[m, me, core.FUEL] * scales[5]
-    out[o + 6] = ship_counters[m, me, core.TORPS] * scales[6]
-    out[o + 7] = ship_counters[m, me, core.HYPER_LEFT] * scales[7]
-    out[o + 8] = ship_counters[m, me, core.ALIVE]
-    out[o + 9] = ship_counters[m, me, core.IN_HYPER]
+    _write_gauges(out, o + 2, m, me, ship_gauges, ship_counters, scales)
     out[o + 10] = ship_counters[m, me, core.RELOAD] * scales[8]
     out[o + 11] = ship_counters[m, me, core.HYPER_RECHARGE] * scales[9]
     out[o + 12] = _sign(charge[m, me])
@@ -135,19 +142,11 @@ def write_learning(m, seat, pos, vel, charge, active, ship_gauges, ship_counters
     out[_STAR + 1] = space.wrap_scalar(0.0 - y0, side) * sp
     # the enemy
     e = _ENEMY
-    he = ship_gauges[m, en, core.HEADING]
     out[e] = space.wrap_scalar(pos[m, 0, en] - x0, side) * sp
     out[e + 1] = space.wrap_scalar(pos[m, 1, en] - y0, side) * sp
     out[e + 2] = (vel[m, 0, en] - vx0) * sv
     out[e + 3] = (vel[m, 1, en] - vy0) * sv
-    out[e + 4] = math.cos(he)
-    out[e + 5] = math.sin(he)
-    out[e + 6] = ship_gauges[m, en, core.OMEGA] * scales[4]
-    out[e + 7] = ship_gauges[m, en, core.FUEL] * scales[5]
-    out[e + 8] = ship_counters[m, en, core.TORPS] * scales[6]
-    out[e + 9] = ship_counters[m, en, core.HYPER_LEFT] * scales[7]
-    out[e + 10] = ship_counters[m, en, core.ALIVE]
-    out[e + 11] = ship_counters[m, en, core.IN_HYPER]
+    _write_gauges(out, e + 4, m, en, ship_gauges, ship_counters, scales)
     out[e + 12] = _sign(charge[m, en])
     # the torpedo slots, own first
     o = _TORPEDOES
