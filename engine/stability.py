@@ -84,6 +84,7 @@ from numba import njit
 from .forces import gravity as _gravity
 from .forces import point_mass as _point_mass
 from .forces import springs as _springs
+from .forces._kernels import pair_box
 from .integrators import INTEGRATORS, check_name
 from .integrators.dormand_prince import _A as _DP_A
 from .integrators.splitting import SCHEMES
@@ -470,8 +471,8 @@ def gravity_frequency(sim):
     for s in range(len(model.kinds)):
         f0 = model.param_offsets[s]
         if model.kinds[s] == _gravity.KIND:
-            G, eps2, own_box = model.params[f0], model.params[f0 + 1], model.params[f0 + 2]
-            box = own_box if own_box > 0.0 else state.box
+            G, eps2 = model.params[f0], model.params[f0 + 1]
+            box = pair_box(model.params, f0, state)
             top = max(top, _gravity_rate(state.pos, state.mass, state.active, state.test,
                                          moving, n, G, eps2, box))
         elif model.kinds[s] == _point_mass.KIND:

@@ -40,12 +40,6 @@ def with_motion(state, pos, vel):
                  state.pinned, state.n, state.box)
 
 
-@njit(cache=True, inline="always")
-def with_parameters(model, params):
-    """The same terms with another float parameter row (one system of a batch)."""
-    return Model(model.kinds, params, model.param_offsets, model.indices, model.index_offsets)
-
-
 #: fields ``first_invalid`` reports, by their code
 INVALID_FIELDS = ("", "pos", "vel", "mass", "charge", "radius")
 
@@ -92,5 +86,5 @@ def first_invalid(state):
     return 0
 
 
-__all__ = ["State", "Model", "Workspace", "EMPTY_WORKSPACE", "with_motion", "with_parameters",
+__all__ = ["State", "Model", "Workspace", "EMPTY_WORKSPACE", "with_motion",
            "first_invalid", "INVALID_FIELDS"]

@@ -138,11 +138,11 @@ class SpacewarVectorEnv(VectorEnv):
     def step(self, actions):
         if self._batch is None:
             raise RuntimeError("call reset() before step()")
-        codes = codes_from_parts(actions)
-        if codes.shape[0] != self.num_envs or np.any(np.asarray(actions) < 0) \
-                or not self.action_space.contains(np.asarray(actions, dtype=np.int64)):
+        parts = np.asarray(actions, dtype=np.int64)
+        if not self.action_space.contains(parts):
             raise ValueError(f"actions must be {self.num_envs} MultiDiscrete{list(NVEC)} actions, "
                              f"got {np.asarray(actions).tolist()!r:.200}")
+        codes = codes_from_parts(parts)
         if self.opponent is None:
             self._codes[:] = codes.reshape(self.matches, 2)
         else:

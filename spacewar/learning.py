@@ -258,7 +258,7 @@ class LearningBatch:
         if isinstance(frame_cap, bool) or not isinstance(frame_cap, (int, np.integer)) \
                 or frame_cap < 0:
             raise ValueError(f"frame_cap must be an int >= 0, got {frame_cap!r}")
-        self.game = Game(rules, seeds=[0] * int(matches) if matches else [], rounds=rounds)
+        self.game = Game(rules, seeds=[0] * int(matches), rounds=rounds)  # streams set per episode
         self.rules = self.game.rules
         self.frame_cap = int(frame_cap)
         self.base = seed_state(seed)

@@ -388,6 +388,20 @@ def bench_spacewar(matches=256, frames=2000):
     }
 
 
+def _each_thread_count():
+    """1, then every thread numba has: numba's thread count set to each in turn while the
+    caller measures, and put back afterwards."""
+    import numba
+
+    threads = numba.get_num_threads()
+    try:
+        for count in sorted({1, numba.config.NUMBA_NUM_THREADS}):
+            numba.set_num_threads(count)
+            yield count
+    finally:
+        numba.set_num_threads(threads)
+
+
 # -- 7. Many systems per call: engine.Batch ----------------------------------------------------
 def _batch_scene(systems, slots, seed=1):
     """The game's size and forces: 2 ships and slots - 2 test particles per system on the unit
@@ -408,8 +422,6 @@ def _batch_terms():
 def bench_batch(systems=4096, slots=66, repeats=5):
     """Systems advanced per second: one ``Batch.step`` for all against one ``Simulation.step``
     per system, at 1 and at every thread; one frame (one step) per call, as a game takes."""
-    import numba
-
     from engine import Batch, Simulation
 
     scene = _batch_scene(systems, slots)
@@ -437,16 +449,11 @@ def bench_batch(systems=4096, slots=66, repeats=5):
             sim.step(1)
 
     rows = {}
-    threads = numba.get_num_threads()
-    try:
-        for count in sorted({1, numba.config.NUMBA_NUM_THREADS}):
-            numba.set_num_threads(count)
-            t_batch, t_sims, ratio = side_by_side(lambda: batch.step(1), separate, repeats)
-            rows[str(count)] = {"batch_systems_per_second": systems / t_batch,
-                                "separate_simulations_per_second": systems / t_sims,
-                                "speedup": ratio}
-    finally:
-        numba.set_num_threads(threads)
+    for count in _each_thread_count():
+        t_batch, t_sims, ratio = side_by_side(lambda: batch.step(1), separate, repeats)
+        rows[str(count)] = {"batch_systems_per_second": systems / t_batch,
+                            "separate_simulations_per_second": systems / t_sims,
+                            "speedup": ratio}
     # the same steps, the same numbers: the batch is bit-identical to the separate simulations
     same = all(np.array_equal(batch.pos[m], sims[m].pos) for m in range(0, systems, 97))
     return {"systems": systems, "slots": slots, "threads": rows,
@@ -458,28 +465,21 @@ def bench_learning(matches=4096, frames=50, repeats=3):
     """Match-frames per second of ``LearningBatch.step`` (random actions; observations,
     rewards, terminations and resets included), at 1 thread and at every thread, with the
     results compared between the two."""
-    import numba
-
     from spacewar.learning import LearningBatch
 
     codes = np.random.default_rng(0).integers(0, 24, size=(frames, matches, 2))
     rows, finals = {}, []
-    threads = numba.get_num_threads()
-    try:
-        for count in sorted({1, numba.config.NUMBA_NUM_THREADS}):
-            numba.set_num_threads(count)
-            batch = LearningBatch(matches, seed=1, rounds=3, frame_cap=3000)
-            batch.step(codes[0])
-            best = math.inf
-            for _ in range(repeats):
-                start = time.perf_counter()
-                for f in range(frames):
-                    batch.step(codes[f])
-                best = min(best, time.perf_counter() - start)
-            rows[str(count)] = {"match_frames_per_second": matches * frames / best}
-            finals.append(batch.observations.copy())
-    finally:
-        numba.set_num_threads(threads)
+    for count in _each_thread_count():
+        batch = LearningBatch(matches, seed=1, rounds=3, frame_cap=3000)
+        batch.step(codes[0])
+        best = math.inf
+        for _ in range(repeats):
+            start = time.perf_counter()
+            for f in range(frames):
+                batch.step(codes[f])
+            best = min(best, time.perf_counter() - start)
+        rows[str(count)] = {"match_frames_per_second": matches * frames / best}
+        finals.append(batch.observations.copy())
     same = all(np.array_equal(finals[0], other) for other in finals[1:])
     return {"matches": matches, "threads": rows, "identical_across_threads": bool(same)}
 

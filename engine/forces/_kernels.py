@@ -30,3 +30,11 @@ def delta_periodic(pos, i, j, dim, box):
     """p_j - p_i, by the nearest periodic image when ``box`` > 0."""
     dx, dy, dz = delta(pos, i, j, dim)
     return nearest_image(dx, box), nearest_image(dy, box), nearest_image(dz, box)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def pair_box(params, f0, state):
+    """The periodic side a pair term (gravity, Coulomb) uses: its own deprecated ``box`` at
+    ``params[f0 + 2]`` when set, else the space's."""
+    own = params[f0 + 2]
+    return own if own > 0.0 else state.box

@@ -13,7 +13,7 @@ import warnings
 from numba import njit
 
 from . import pairwise
-from ._kernels import add_force, delta_periodic
+from ._kernels import add_force, delta_periodic, pair_box
 from .base import Force, floats, EMPTY_INTS
 from .._validate import nonnegative_float, finite_float, optional, positive_float
 
@@ -27,10 +27,9 @@ def accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work):
     charge = state.charge
     active = state.active
     n = state.n
-    space = state.box
     k = params[f0]
     eps2 = params[f0 + 1]
-    box = params[f0 + 2] if params[f0 + 2] > 0.0 else space  # a deprecated own box, else the space's
+    box = pair_box(params, f0, state)
     dim = pos.shape[0]
     if pairwise.usable(n, work):
         pairwise.coulomb(pos, mass, charge, active, n, k, eps2, box, acc, work)
@@ -55,10 +54,9 @@ def potential(t, state, params, f0, f1, indices, i0, i1):
     charge = state.charge
     active = state.active
     n = state.n
-    space = state.box
     k = params[f0]
     eps2 = params[f0 + 1]
-    box = params[f0 + 2] if params[f0 + 2] > 0.0 else space  # a deprecated own box, else the space's
+    box = pair_box(params, f0, state)
     dim = pos.shape[0]
     u = 0.0
     for i in range(n):

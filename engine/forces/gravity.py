@@ -17,7 +17,7 @@ import warnings
 from numba import njit
 
 from . import pairwise
-from ._kernels import delta_periodic, nearest_image
+from ._kernels import delta_periodic, nearest_image, pair_box
 from .base import Force, floats, EMPTY_INTS
 from .._validate import nonnegative_float, one_of, optional, positive_float
 
@@ -70,10 +70,9 @@ def accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work):
     active = state.active
     test = state.test
     n = state.n
-    space = state.box
     G = params[f0]
     eps2 = params[f0 + 1]
-    box = params[f0 + 2] if params[f0 + 2] > 0.0 else space  # a deprecated own box, else the space's
+    box = pair_box(params, f0, state)
     if pairwise.usable(n, work):
         single = params[f0 + 3] != 0.0
         pairwise.gravity(pos, mass, active, test, n, G, eps2, box, single, acc, work)
@@ -125,10 +124,9 @@ def potential(t, state, params, f0, f1, indices, i0, i1):
     active = state.active
     test = state.test
     n = state.n
-    space = state.box
     G = params[f0]
     eps2 = params[f0 + 1]
-    box = params[f0 + 2] if params[f0 + 2] > 0.0 else space  # a deprecated own box, else the space's
+    box = pair_box(params, f0, state)
     dim = pos.shape[0]
     u = 0.0
     for i in range(n):
