@@ -18,7 +18,7 @@ import math
 import numpy as np
 
 from engine import space
-from engine.batch import advance_system
+from engine.batch import advance_system_in
 from engine.cache import compiler
 from engine.integrators import splitting
 from engine.state import Model, State, Workspace
@@ -318,10 +318,11 @@ def _round_logic(m, pos, vel, mass, charge, active, ship_gauges, ship_counters, 
 
 @jit()
 def step_match(m, actions, state, model, work, ship_gauges, ship_counters, torp_life,
-               match_state, rng, rules, drifts, kicks, doomed):
+               match_state, rng, rules, drifts, kicks, doomed, scratch):
     """Advance match ``m`` by one frame with ``actions[m, 0]`` and ``actions[m, 1]``.
 
-    ``state`` and ``model`` are the match batch's ``engine.Batch.kernel_arguments()``."""
+    ``state`` and ``model`` are the match batch's ``engine.Batch.kernel_arguments()``;
+    ``scratch`` is the engine step's (``new_scratch``), reused from match to match."""
     if match_state[m, OVER] == 1:
         return
     pos = state.pos
@@ -336,7 +337,8 @@ def step_match(m, actions, state, model, work, ship_gauges, ship_counters, torp_
                  ship_gauges, ship_counters, torp_life, force_params, rng, rules)
     # motion: the engine's symplectic Euler kernel on this match's system, dt = 1 frame, with
     # the engine's forces; its drift wraps positions onto the torus (the batch's box = 1)
-    _, _, _, status = advance_system(m, 0.0, 1.0, 1, state, model, work, False, drifts, kicks)
+    _, _, _, status = advance_system_in(m, 0.0, 1.0, 1, state, model, work, False, drifts, kicks,
+                                        scratch)
     if status >= 0:
         match_state[m, ERROR] = 1
         match_state[m, OVER] = 1
@@ -350,6 +352,13 @@ def step_match(m, actions, state, model, work, ship_gauges, ship_counters, torp_
     _collisions(m, pos, vel, active, ship_counters, torp_life, match_state, rules, doomed)
     _round_logic(m, pos, vel, mass, charge, active, ship_gauges, ship_counters, torp_life,
                  match_state, rules)
+
+
+@jit(inline="always")
+def new_scratch(pos):
+    """The engine step's scratch for one match of the batch (``pos`` is (M, dim, n)), which
+    one thread reuses for every match it steps: a frame allocates nothing per match."""
+    return np.empty((splitting.scratch_rows(pos.shape[1]), pos.shape[2]))
 
 
 @jit()
@@ -366,9 +375,10 @@ def step_all(actions, pos, vel, mass, charge, radius, active, test, pinned, n, b
     # the game's pair forces run the engine's scalar pair loop (no large-N workspace), as the
     # recorded replays were played
     work = Workspace(np.empty(0), np.empty(0, dtype=np.int64), False)
+    scratch = new_scratch(pos)
     for m in range(pos.shape[0]):
         step_match(m, actions, state, model, work, ship_gauges, ship_counters, torp_life,
-                   match_state, rng, rules, drifts, kicks, doomed)
+                   match_state, rng, rules, drifts, kicks, doomed, scratch)
 
 
 @jit()

@@ -34,6 +34,9 @@ from .rules import Rules
 
 jit = core.jit
 
+#: matches are handed to the threads in this many chunks at most (one scratch space each)
+CHUNKS = 256
+
 HEADER = ("round_time_fraction", "rounds_fraction", "score_difference", "star_present",
           "star_strength", "electric")
 OWN = ("vx", "vy", "cos_heading", "sin_heading", "turn_rate", "fuel_fraction",
@@ -209,7 +212,28 @@ def step_learning(actions, pos, vel, mass, charge, radius, active, test, pinned,
     state = State(pos, vel, mass, charge, radius, active, test, pinned, n, box)
     model = Model(kinds, params, param_offsets, indices, index_offsets)
     work = Workspace(np.empty(0), np.empty(0, dtype=np.int64), False)
-    for m in prange(pos.shape[0]):
+    matches = pos.shape[0]
+    chunks = min(matches, CHUNKS)
+    for c in prange(chunks):
+        scratch = core.new_scratch(pos)
+        for m in range(c * matches // chunks, (c + 1) * matches // chunks):
+            _learning_frame(m, actions, state, model, work, ship_gauges, ship_counters,
+                            torp_life, match_state, rng, rules, drifts, kicks, doomed, scratch,
+                            scales, base, episodes, frame_cap, pending, observations, rewards,
+                            terminated, truncated)
+
+
+@jit(inline="always")
+def _learning_frame(m, actions, state, model, work, ship_gauges, ship_counters, torp_life,
+                    match_state, rng, rules, drifts, kicks, doomed, scratch, scales, base,
+                    episodes, frame_cap, pending, observations, rewards, terminated, truncated):
+    """Match m's share of ``step_learning``."""
+    pos = state.pos
+    vel = state.vel
+    mass = state.mass
+    charge = state.charge
+    active = state.active
+    if True:
         rewards[m, 0] = 0.0
         rewards[m, 1] = 0.0
         terminated[m] = False
@@ -224,7 +248,7 @@ def step_learning(actions, pos, vel, mass, charge, radius, active, test, pinned,
             s0 = match_state[m, core.SCORE0]
             s1 = match_state[m, core.SCORE1]
             core.step_match(m, actions, state, model, work, ship_gauges, ship_counters, torp_life,
-                            match_state, rng, rules, drifts, kicks, doomed)
+                            match_state, rng, rules, drifts, kicks, doomed, scratch)
             d0 = match_state[m, core.SCORE0] - s0
             d1 = match_state[m, core.SCORE1] - s1
             if d0 > 0 and d1 == 0:

@@ -81,9 +81,15 @@ def copy_state(src_pos, src_vel, dst_pos, dst_vel, n):
 def active_mask(active, pinned, n):
     """1.0 for the particles that move (active and not pinned), else 0.0."""
     mask = np.empty(n)
+    fill_active_mask(mask, active, pinned, n)
+    return mask
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def fill_active_mask(mask, active, pinned, n):
+    """``active_mask`` into a caller's array."""
     for i in range(n):
         mask[i] = 1.0 if active[i] and not pinned[i] else 0.0
-    return mask
 
 
 @njit(cache=True, error_model="numpy", inline="always")

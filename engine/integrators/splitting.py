@@ -24,7 +24,7 @@ from numba import njit
 
 from ..forces.dispatch import accelerations
 from . import fused_gravity
-from .common import OK, active_mask, all_finite, copy_state, drift, first_nonfinite, kick
+from .common import OK, all_finite, copy_state, drift, fill_active_mask, first_nonfinite, kick
 
 _W1 = 1.0 / (2.0 - 2.0 ** (1.0 / 3.0))
 _W0 = 1.0 - 2.0 * _W1
@@ -64,6 +64,13 @@ def force_evaluations(name):
     return kicks - (1 if starts_with_kick and ends_with_kick else 0)
 
 
+@njit(cache=True, inline="always")
+def scratch_rows(dim):
+    """Rows of the scratch ``advance_in`` needs for a system of dimension ``dim``: the
+    accelerations, the saved positions and velocities (dim rows each) and the motion mask."""
+    return 3 * dim + 1
+
+
 @njit(cache=True, error_model="numpy")
 def advance(t, h, steps, state, model, work, vdep, t_end, drifts, kicks):
     """``steps`` steps of the scheme (drift ``drifts[k] h``, then kick ``kicks[k] h``)."""
@@ -71,6 +78,25 @@ def advance(t, h, steps, state, model, work, vdep, t_end, drifts, kicks):
         f0 = model.param_offsets[0]
         return fused_gravity.advance(t, h, steps, state.pos, state.vel, state.mass, state.active,
                                      state.n, model.params[f0], model.params[f0 + 1], drifts, kicks)
+    scratch = np.empty((scratch_rows(state.pos.shape[0]), state.n))
+    return _advance_general(t, h, steps, state, model, work, vdep, drifts, kicks, scratch)
+
+
+@njit(cache=True, error_model="numpy")
+def advance_in(t, h, steps, state, model, work, vdep, t_end, drifts, kicks, scratch):
+    """``advance`` in caller-owned ``scratch`` of at least ``scratch_rows(dim)`` rows and
+    ``n`` columns, so that a compiled caller stepping many small systems (the game's
+    matches) allocates nothing per system. Same operations, same bits."""
+    if fused_gravity.applies(state, model):
+        f0 = model.param_offsets[0]
+        return fused_gravity.advance(t, h, steps, state.pos, state.vel, state.mass, state.active,
+                                     state.n, model.params[f0], model.params[f0 + 1], drifts, kicks)
+    return _advance_general(t, h, steps, state, model, work, vdep, drifts, kicks, scratch)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _advance_general(t, h, steps, state, model, work, vdep, drifts, kicks, scratch):
+    """The general executor, every declared force through the dispatch table."""
     pos = state.pos
     vel = state.vel
     active = state.active
@@ -80,10 +106,11 @@ def advance(t, h, steps, state, model, work, vdep, t_end, drifts, kicks):
     # sliced inside the loop, since each of those costs atomic reference-count updates that
     # would outweigh the physics of a small system many times over.
     dim = pos.shape[0]
-    acc = np.empty((dim, n))
-    mask = active_mask(active, state.pinned, n)
-    save_pos = np.empty((dim, n))
-    save_vel = np.empty((dim, n))
+    acc = scratch[0:dim]
+    save_pos = scratch[dim:2 * dim]
+    save_vel = scratch[2 * dim:3 * dim]
+    mask = scratch[3 * dim]
+    fill_active_mask(mask, active, state.pinned, n)
     fresh = False  # does acc hold the forces of the current state?
     t0 = t
     for step in range(steps):

@@ -1,0 +1,367 @@
+"""Trained policies as ``.npz`` files: saving, safe loading, and NumPy inference (no JAX).
+
+    from spacewar.policy import Policy, PolicyBot
+    policy = Policy.load("policy.npz")             # validated; never unpickles anything
+    codes = policy.act_batch(obs)                  # (K, D) float32 -> (K,) int64 action codes
+    bot = PolicyBot("policy.npz")                  # a bot: bot.act(observation) -> Action
+
+A policy file is a NumPy ``.npz`` archive written by ``spacewar.train`` (``save_policy``) and
+read here with ``np.load(..., allow_pickle=False)``: it holds only numeric arrays and one
+JSON text, so loading one runs no code from it. Its fields:
+
+- ``format`` (the text ``"spacewar-policy"``), ``format_version`` (int64, now 1);
+- ``metadata``: a JSON object: ``observation_length`` (D), ``rules`` (``Rules.to_dict()``),
+  ``rounds`` (the match length it was trained at), ``layout_sha256`` (of the learning layout's
+  names), ``action_format`` (``"MultiDiscrete[3,2,2,2]"``), ``nvec`` ([3, 2, 2, 2]),
+  ``activation`` (``"tanh"`` or ``"relu"``), ``layers`` (how many weight matrices),
+  ``frame_skip`` (frames each decision is held for) and ``training`` (how it was made);
+- ``inputs``: int64 indices of the learning observation entries the network reads (the
+  entries scaled by the match's number of rounds are left out: a bot is not told that number);
+- ``w0, b0, ..., w{L-1}, b{L-1}``: float32 weights and biases of the MLP
+  ``h_{i+1} = act(h_i W_i + b_i)``, the last layer linear: 9 logits, the four categorical
+  factors (turn 3, thrust 2, fire 2, hyperspace 2) side by side.
+
+Every array is checked for its dtype, shape and finiteness before use; a bad file raises
+``PolicyError`` naming the field.
+"""
+import hashlib
+import io
+import json
+import math
+import os
+import zipfile
+
+import numpy as np
+
+FORMAT = "spacewar-policy"
+FORMAT_VERSION = 1
+NVEC = (3, 2, 2, 2)
+ACTION_FORMAT = "MultiDiscrete[3,2,2,2]"
+ACTIVATIONS = ("tanh", "relu")
+#: the learning observation entries a policy never reads (they are scaled by the match's
+#: number of rounds, which ``Observation`` does not carry)
+ROUND_SCALED = ("rounds_fraction", "score_difference")
+MAX_ELEMENTS = 1 << 26  # no policy array is larger than 64 Mi numbers (256 MiB of float32)
+MAX_LAYERS = 16
+MAX_FRAME_SKIP = 64
+_OFFSETS = np.cumsum((0,) + NVEC)  # where each factor's logits start
+_WEIGHTS = tuple(int(w) for w in (1, 3, 6, 12))  # game code = turn + 3 thrust + 6 fire + 12 hyperspace
+
+
+class PolicyError(ValueError):
+    """A policy file that cannot be used (the message names the field and says why)."""
+
+
+def layout_sha256(names):
+    """SHA-256 of a learning layout's names (one per line): ties a policy to its inputs."""
+    return hashlib.sha256("\n".join(names).encode()).hexdigest()
+
+
+def default_inputs(rules):
+    """Indices of the learning observation entries a policy reads under ``rules``."""
+    from .learning import learning_layout
+
+    return np.array([k for k, name in enumerate(learning_layout(rules))
+                     if name not in ROUND_SCALED], dtype=np.int64)
+
+
+def codes_from_parts(parts):
+    """(K, 4) factor choices (turn, thrust, fire, hyperspace) as game action codes (K,)."""
+    parts = np.asarray(parts, dtype=np.int64).reshape(-1, 4)
+    return parts @ np.array(_WEIGHTS, dtype=np.int64)
+
+
+# -- saving ---------------------------------------------------------------------------------
+def check_policy_path(path):
+    """Raise unless ``path`` can receive a policy file (call it before training): its
+    directory must be writable and an existing file there must be an ``.npz`` (zip)."""
+    from engine.atomic import OutputPathError, check_output_path
+
+    path = check_output_path(path)
+    if os.path.isfile(path) and os.path.getsize(path) > 0:
+        with open(path, "rb") as f:
+            head = f.read(4)
+        if head != b"PK\x03\x04":
+            raise OutputPathError(f"refusing to write the policy {path!r}: the file exists and "
+                                  "is not an .npz archive; choose another path or remove it")
+    return path
+
+
+def save_policy(path, weights, metadata):
+    """Write a policy file atomically (temporary file, then ``os.replace``); return ``path``.
+
+    ``weights`` maps ``w0, b0, ...`` and ``inputs`` to arrays; ``metadata`` is the JSON
+    object described in the module's text. The result is loaded back and validated before it
+    replaces anything at ``path``, so a policy file that is written can also be read."""
+    from engine.atomic import atomic_write
+
+    arrays = {"format": np.array(FORMAT), "format_version": np.array(FORMAT_VERSION, np.int64),
+              "metadata": np.array(json.dumps(metadata, sort_keys=True))}
+    for name, value in weights.items():
+        arrays[name] = np.ascontiguousarray(value)
+    buffer = io.BytesIO()
+    np.savez(buffer, **arrays)
+    data = buffer.getvalue()
+    _parse(_read_npz(io.BytesIO(data), "the policy being saved"), "the policy being saved")
+    return atomic_write(path, data, mode="wb")
+
+
+# -- loading and validation -----------------------------------------------------------------
+def _read_npz(source, where):
+    """Every array of an .npz, its header checked (dtype, size) before its data is read."""
+    try:
+        with zipfile.ZipFile(source) as archive:
+            for info in archive.infolist():
+                if not info.filename.endswith(".npy"):
+                    raise PolicyError(f"{where}: unexpected member {info.filename!r} in the archive")
+                with archive.open(info) as f:
+                    try:
+                        version = np.lib.format.read_magic(f)
+                        read_header = {(1, 0): np.lib.format.read_array_header_1_0,
+                                       (2, 0): np.lib.format.read_array_header_2_0}.get(version)
+                        if read_header is None:
+                            raise ValueError(f"unknown .npy format version {version}")
+                        shape, _, dtype = read_header(f)
+                    except ValueError as exc:
+                        raise PolicyError(f"{where}: field {info.filename[:-4]!r} is not a "
+                                          f"NumPy array: {exc}") from None
+                if dtype.hasobject:
+                    raise PolicyError(f"{where}: field {info.filename[:-4]!r} holds Python objects "
+                                      "(pickled data), which a policy never does")
+                if math.prod(shape) > MAX_ELEMENTS:
+                    raise PolicyError(f"{where}: field {info.filename[:-4]!r} has shape {shape}, "
+                                      f"over the {MAX_ELEMENTS} numbers a policy array may hold")
+    except zipfile.BadZipFile as exc:
+        raise PolicyError(f"{where} is not an .npz archive: {exc}") from None
+    if hasattr(source, "seek"):
+        source.seek(0)
+    try:
+        with np.load(source, allow_pickle=False) as npz:
+            return {name: npz[name] for name in npz.files}
+    except (ValueError, OSError, EOFError, zipfile.BadZipFile) as exc:
+        raise PolicyError(f"{where} cannot be read as an .npz archive: {exc}") from None
+
+
+def _field(arrays, name, where):
+    if name not in arrays:
+        raise PolicyError(f"{where}: missing field {name!r}")
+    return arrays[name]
+
+
+def _text(arrays, name, where):
+    value = _field(arrays, name, where)
+    if value.dtype.kind != "U" or value.shape != ():
+        raise PolicyError(f"{where}: field {name!r} must be a text (0-d unicode array), got "
+                          f"{value.dtype} of shape {value.shape}")
+    return str(value)
+
+
+def _meta(meta, key, kind, where, check=None, why=""):
+    if key not in meta:
+        raise PolicyError(f"{where}: metadata field {key!r} is missing")
+    value = meta[key]
+    if isinstance(value, bool) and kind is not bool or not isinstance(value, kind) \
+            or (check is not None and not check(value)):
+        raise PolicyError(f"{where}: metadata field {key!r} must be {why or kind.__name__}, "
+                          f"got {value!r:.100}")
+    return value
+
+
+def _parse(arrays, where):
+    """Validate loaded arrays; return ``(metadata, inputs, layers)`` or raise PolicyError."""
+    from .learning import learning_layout, learning_length
+    from .rules import Rules
+
+    fmt = _text(arrays, "format", where)
+    if fmt != FORMAT:
+        raise PolicyError(f"{where}: field 'format' must be {FORMAT!r}, got {fmt!r:.100}")
+    version = _field(arrays, "format_version", where)
+    if version.dtype != np.int64 or version.shape != ():
+        raise PolicyError(f"{where}: field 'format_version' must be a 0-d int64, got "
+                          f"{version.dtype} of shape {version.shape}")
+    if int(version) != FORMAT_VERSION:
+        raise PolicyError(f"{where}: field 'format_version' is {int(version)}; this version "
+                          f"of spacewar reads version {FORMAT_VERSION}")
+    try:
+        meta = json.loads(_text(arrays, "metadata", where))
+    except (ValueError, RecursionError) as exc:
+        raise PolicyError(f"{where}: field 'metadata' is not valid JSON: {exc}") from None
+    if not isinstance(meta, dict):
+        raise PolicyError(f"{where}: field 'metadata' must be a JSON object")
+    rules_dict = _meta(meta, "rules", dict, where, why="a JSON object of the rules")
+    try:
+        rules = Rules.from_dict(rules_dict)
+    except (TypeError, ValueError, KeyError) as exc:
+        raise PolicyError(f"{where}: metadata field 'rules' is not valid rules: {exc}") from None
+    d = _meta(meta, "observation_length", int, where, lambda v: v == learning_length(rules),
+              f"the learning observation length under its rules ({learning_length(rules)})")
+    _meta(meta, "layout_sha256", str, where, lambda v: v == layout_sha256(learning_layout(rules)),
+          "the SHA-256 of this version's learning layout (the observation's entries changed "
+          "since the policy was trained: train it again)")
+    _meta(meta, "rounds", int, where, lambda v: 1 <= v <= 10_000, "an int in [1, 10000]")
+    _meta(meta, "action_format", str, where, lambda v: v == ACTION_FORMAT, repr(ACTION_FORMAT))
+    _meta(meta, "nvec", list, where, lambda v: v == list(NVEC), str(list(NVEC)))
+    _meta(meta, "activation", str, where, lambda v: v in ACTIVATIONS, f"one of {ACTIVATIONS}")
+    n_layers = _meta(meta, "layers", int, where, lambda v: 1 <= v <= MAX_LAYERS,
+                     f"an int in [1, {MAX_LAYERS}]")
+    _meta(meta, "frame_skip", int, where, lambda v: 1 <= v <= MAX_FRAME_SKIP,
+          f"an int in [1, {MAX_FRAME_SKIP}]")
+    meta["rules_object"] = rules
+    inputs = _field(arrays, "inputs", where)
+    if inputs.dtype != np.int64 or inputs.ndim != 1 or inputs.size == 0:
+        raise PolicyError(f"{where}: field 'inputs' must be a non-empty 1-d int64 array, got "
+                          f"{inputs.dtype} of shape {inputs.shape}")
+    if inputs.min() < 0 or inputs.max() >= d or np.any(np.diff(inputs) <= 0):
+        raise PolicyError(f"{where}: field 'inputs' must be increasing indices in [0, {d})")
+    expected = {"format", "format_version", "metadata", "inputs"}
+    layers = []
+    width = inputs.size
+    for i in range(n_layers):
+        w, b = _field(arrays, f"w{i}", where), _field(arrays, f"b{i}", where)
+        last = i == n_layers - 1
+        out = int(sum(NVEC)) if last else (w.shape[1] if w.ndim == 2 else -1)
+        for name, value, shape in ((f"w{i}", w, (width, out)), (f"b{i}", b, (out,))):
+            if value.dtype != np.float32:
+                raise PolicyError(f"{where}: field {name!r} must be float32, got {value.dtype}")
+            if value.shape != shape or out < 1:
+                raise PolicyError(f"{where}: field {name!r} must have shape {shape}, got "
+                                  f"{value.shape}")
+            if not np.all(np.isfinite(value)):
+                raise PolicyError(f"{where}: field {name!r} holds non-finite numbers")
+        layers.append((w, b))
+        expected |= {f"w{i}", f"b{i}"}
+        width = out
+    extra = sorted(set(arrays) - expected)
+    if extra:
+        raise PolicyError(f"{where}: unexpected fields {extra} (a policy of {n_layers} layers "
+                          f"has {sorted(expected)})")
+    return meta, inputs, layers
+
+
+def _activation(name):
+    if name == "tanh":
+        return np.tanh
+    return lambda x: np.maximum(x, 0.0)
+
+
+class Policy:
+    """A loaded, validated policy: NumPy inference of the MLP of the module's text."""
+
+    def __init__(self, metadata, inputs, layers):
+        self.metadata = {k: v for k, v in metadata.items() if k != "rules_object"}
+        self.rules = metadata["rules_object"]
+        self.observation_length = int(metadata["observation_length"])
+        self.rounds = int(metadata["rounds"])
+        self.frame_skip = int(metadata["frame_skip"])
+        self.activation = metadata["activation"]
+        self.inputs = inputs
+        self.layers = [(np.asarray(w, np.float32), np.asarray(b, np.float32)) for w, b in layers]
+        self._act = _activation(self.activation)
+
+    @classmethod
+    def load(cls, path):
+        """Read and validate a policy file (``np.load(..., allow_pickle=False)``)."""
+        where = f"policy file {os.fspath(path)!r}"
+        try:
+            with open(path, "rb") as f:
+                data = f.read()
+        except OSError as exc:
+            raise PolicyError(f"cannot read {where}: {exc.strerror or exc}") from None
+        return cls(*_parse(_read_npz(io.BytesIO(data), where), where))
+
+    def logits(self, obs):
+        """The 9 logits (turn 3, thrust 2, fire 2, hyperspace 2) of each row of ``obs``
+        ((K, D) learning observations), float32 (K, 9)."""
+        obs = np.asarray(obs)
+        if obs.ndim != 2 or obs.shape[1] != self.observation_length:
+            raise ValueError(f"obs must have shape (K, {self.observation_length}), got {obs.shape}")
+        h = obs[:, self.inputs].astype(np.float32, copy=False)
+        for i, (w, b) in enumerate(self.layers):
+            h = h @ w + b
+            if i < len(self.layers) - 1:
+                h = self._act(h)
+        return h
+
+    def act_batch(self, obs, greedy=True, rng=None):
+        """Game action codes (K,) int64 for learning observations ``obs`` (K, D) float32.
+
+        Greedy (each factor's most likely choice) by default; ``greedy=False`` samples each
+        factor from its softmax with ``rng`` (a ``numpy.random.Generator``; required, so that
+        sampling is always seeded)."""
+        obs = np.asarray(obs)
+        if obs.dtype != np.float32:
+            raise ValueError(f"obs must be float32 learning observations, got {obs.dtype}")
+        z = self.logits(obs)
+        parts = np.empty((z.shape[0], len(NVEC)), dtype=np.int64)
+        if not greedy and not isinstance(rng, np.random.Generator):
+            raise ValueError("sampling (greedy=False) needs rng, a numpy.random.Generator")
+        for f in range(len(NVEC)):
+            zf = z[:, _OFFSETS[f]:_OFFSETS[f + 1]]
+            if greedy:
+                parts[:, f] = np.argmax(zf, axis=1)
+            else:
+                p = np.exp(zf - zf.max(axis=1, keepdims=True))
+                c = np.cumsum(p / p.sum(axis=1, keepdims=True), axis=1)
+                u = rng.random((zf.shape[0], 1))
+                parts[:, f] = np.minimum((u > c).sum(axis=1), zf.shape[1] - 1)
+        return codes_from_parts(parts)
+
+
+class PolicyBot:
+    """A bot playing a policy file: ``act(obs)`` for the game's ``Observation``.
+
+    It rebuilds the learning observation from the raw numbers the observation carries
+    (``spacewar.learning.learning_vector``), decides every ``frame_skip`` frames (the policy
+    was trained holding each decision that long) and holds the action in between. The
+    observation does not say how many rounds the match has, so the entries scaled by it are
+    computed with the training value and are not read by the network anyway. ``greedy=False``
+    samples actions from a generator seeded by ``seed``. A match under other rules than the
+    policy's is refused (``strict_rules=False`` plays it when the observation length fits)."""
+
+    def __init__(self, policy, seed=None, greedy=True, strict_rules=True):
+        self.policy = policy if isinstance(policy, Policy) else Policy.load(policy)
+        self.greedy = bool(greedy)
+        self.seed = seed
+        self.strict_rules = strict_rules
+        self.reset()
+
+    def reset(self):
+        self._rng = np.random.default_rng(self.seed)
+        self._held = None
+        self._left = 0
+        self._checked = False
+
+    def _check_rules(self, rules):
+        mine, theirs = self.policy.rules.to_dict(), rules.to_dict()
+        if mine != theirs:
+            diff = {k: (mine.get(k), theirs.get(k)) for k in sorted(set(mine) | set(theirs))
+                    if mine.get(k) != theirs.get(k)}
+            from .learning import learning_length
+
+            if self.strict_rules or learning_length(rules) != self.policy.observation_length:
+                raise ValueError(f"the policy was trained under other rules (field: "
+                                 f"(policy's, match's) = {diff})")
+        self._checked = True
+
+    def act(self, obs):
+        from .learning import learning_vector
+        from .protocol import Action
+
+        if not self._checked:
+            self._check_rules(obs.rules)
+        if self._left == 0:
+            raw = object.__getattribute__(obs, "_raw")
+            if raw is None:
+                raise ValueError("the observation carries no raw numbers to compute a learning "
+                                 "observation from")
+            x = learning_vector(raw, obs.rules, self.policy.rounds)[None]
+            self._held = Action.from_code(int(self.policy.act_batch(
+                x, greedy=self.greedy, rng=self._rng)[0]))
+            self._left = self.policy.frame_skip
+        self._left -= 1
+        return self._held
+
+
+__all__ = ["Policy", "PolicyBot", "PolicyError", "save_policy", "check_policy_path",
+           "default_inputs", "layout_sha256", "codes_from_parts", "FORMAT", "FORMAT_VERSION",
+           "NVEC"]
