@@ -1,21 +1,23 @@
 """Gymnasium environments on the compiled learning batch (``pip install -e '.[rl]'``).
 
     import gymnasium, spacewar.envs             # importing registers "Spacewar-v0"
-    env = gymnasium.make("Spacewar-v0", opponent="random")
-    envs = gymnasium.make_vec("Spacewar-v0", num_envs=4096, opponent="random")   # native
+    env = gymnasium.make("Spacewar-v0", opponent="chaser")
+    envs = gymnasium.make_vec("Spacewar-v0", num_envs=4096, opponent="chaser")   # native
 
 ``SpacewarVectorEnv`` is native (as Gymnasium's ``CartPoleVectorEnv`` is): every match is
-stepped, observed, rewarded and reset by one compiled call of ``spacewar.learning``.
-``SpacewarEnv`` is one match of it.
+stepped, observed, rewarded and restarted, and a compiled opponent decides, inside one
+compiled call of ``spacewar.learning``. ``SpacewarEnv`` is one match of it.
 
 Description
     Spacewar! (1962): two ships, a star, torpedoes and hyperspace on a torus; a learner flies
     seat 0 against an opponent in seat 1 (or, in the vector env with ``opponent=None``, both
-    seats learn: the agent axis is then 2 * num_envs, match m's seats at 2m and 2m + 1).
+    seats learn: the agent axis is then 2 * matches, match m's seats at 2m and 2m + 1).
 Action space
-    ``MultiDiscrete([3, 2, 2, 2])``: turn (0 right, 1 none, 2 left, i.e. turn - 1 of
-    ``spacewar.Action``), thrust, fire, hyperspace; the game's action code is
-    ``turn + 3 thrust + 6 fire + 12 hyperspace``.
+    ``MultiDiscrete([3, 2, 2, 2])`` (``action_type="multi_discrete"``, the default): turn (0
+    right, 1 none, 2 left, i.e. turn - 1 of ``spacewar.Action``), thrust, fire, hyperspace;
+    in the electric mode a fifth entry, the polarity flip, ``MultiDiscrete([3, 2, 2, 2, 2])``.
+    ``action_type="discrete"``: ``Discrete(24)`` (48 in the electric mode), the game's own
+    action code ``turn + 3 thrust + 6 fire + 12 hyperspace + 24 flip``.
 Observation space
     ``Box`` of float32, shape (D,): ``spacewar.learning.learning_layout(rules)`` names the
     entries (egocentric, scaled to about [-1, 1]; see docs/game.md). Relative positions, headings,
@@ -26,12 +28,28 @@ Rewards
 Episode end
     ``terminated`` when the match is over (``rounds`` rounds, plus tie-breaks); ``truncated``
     at ``max_frames`` frames (default 20000).
+Autoreset (vector env)
+    ``autoreset_mode``: ``"next_step"`` (default), ``"same_step"`` (the ended episode's last
+    observation in ``info["final_obs"]``, an object array with the mask ``info["_final_obs"]``,
+    and ``info["final_info"]``) or ``"disabled"`` (``reset(options={"reset_mask": mask})``
+    restarts the ended ones); ``metadata["autoreset_mode"]`` says which.
 Opponents
-    ``"idle"`` (no action) and ``"random"`` (uniform random actions from the env's seed) play
-    inside the batch; the compiled versions of the other built-in bots come next.
+    A compiled bot's name (``spacewar.compiled_bots.KINDS``: they decide inside the compiled
+    call), a policy (an object with ``act_batch(obs (K, D) float32) -> (K,) action codes``, or
+    the path of a policy saved as ``.npz``: all matches in one call, on seat 1's
+    observations), or a Python bot (an object with ``act(Observation) -> Action``: the
+    single-match env only, since a bot keeps state per match), or None (self-play, vector env).
+Seeding
+    ``reset(seed=s)``: match m's episode e plays a stream made from (s, m, e) alone, so runs
+    are reproducible whatever the number of envs or threads.
+Rendering
+    ``SpacewarEnv(render_mode="rgb_array")``: ``render()`` gives a (480, 480, 3) uint8 frame
+    drawn by ``spacewar.render``; ``"human"``: the pygame window (``[viz]`` extra).
 Version history
     v0: first version.
 """
+import os
+
 import numpy as np
 
 try:
@@ -42,16 +60,30 @@ try:
 except ImportError as error:  # pragma: no cover - the extra is missing
     raise ImportError("spacewar.envs needs Gymnasium: pip install -e '.[rl]'") from error
 
-from .learning import LearningBatch, learning_layout, learning_length
+from . import core
+from .learning import LearningBatch, learning_layout, learning_length, seat_kinds
+from .learning import compiled_bots
+from .protocol import action_code
 from .rules import Rules
 
-OPPONENTS = ("idle", "random", None)
+ACTION_TYPES = ("multi_discrete", "discrete")
 NVEC = (3, 2, 2, 2)
 _NOOP_PARTS = (1, 0, 0, 0)
+_AUTORESET = {"next_step": AutoresetMode.NEXT_STEP, "same_step": AutoresetMode.SAME_STEP,
+              "disabled": AutoresetMode.DISABLED}
 
 
-def action_space():
-    return spaces.MultiDiscrete(np.array(NVEC, dtype=np.int64))
+def electric(rules):
+    return rules.mode == "electric"
+
+
+def action_space(rules=None, action_type="multi_discrete"):
+    """The action space under these rules: MultiDiscrete parts, or the flat Discrete code."""
+    rules = Rules() if rules is None else rules
+    flip = electric(rules)
+    if _check("action_type", action_type, ACTION_TYPES) == "discrete":
+        return spaces.Discrete(48 if flip else 24)
+    return spaces.MultiDiscrete(np.array(NVEC + ((2,) if flip else ()), dtype=np.int64))
 
 
 def observation_space(rules):
@@ -72,114 +104,227 @@ def observation_space(rules):
 
 
 def codes_from_parts(parts):
-    """(K, 4) MultiDiscrete actions as the game's action codes (K,)."""
-    parts = np.asarray(parts, dtype=np.int64).reshape(-1, 4)
-    return parts[:, 0] + 3 * parts[:, 1] + 6 * parts[:, 2] + 12 * parts[:, 3]
+    """(K, 4) or (K, 5) MultiDiscrete actions as the game's action codes (K,)."""
+    parts = np.asarray(parts, dtype=np.int64)
+    width = parts.shape[-1] if parts.ndim else 0
+    if width not in (4, 5):
+        raise ValueError(f"MultiDiscrete actions have 4 or 5 parts, got shape {parts.shape}")
+    parts = parts.reshape(-1, width)
+    codes = parts[:, 0] + 3 * parts[:, 1] + 6 * parts[:, 2] + 12 * parts[:, 3]
+    if width == 5:
+        codes = codes + 24 * parts[:, 4]
+    return codes
 
 
 def _check(name, value, allowed):
-    if value not in allowed:
+    if not isinstance(value, (str, type(None))) or value not in allowed:
         raise ValueError(f"{name} must be one of {', '.join(map(repr, allowed))}, got {value!r}")
     return value
 
 
+def _load_policy(path):
+    from .policy import load_policy
+
+    return load_policy(path)
+
+
+class _Opponent:
+    """Seat 1's player as the vector env drives it: compiled (inside the batch), a batch
+    policy (seat 1's observations in, codes out) or a Python bot (one match)."""
+
+    def __init__(self, opponent, num_envs):
+        self.compiled = None
+        self.policy = None
+        self.bot = None
+        if opponent is None or isinstance(opponent, str) and opponent in compiled_bots.KINDS:
+            self.compiled = opponent
+        elif isinstance(opponent, (str, os.PathLike)) and str(opponent).endswith(".npz"):
+            self.policy = _load_policy(opponent)
+        elif hasattr(opponent, "act_batch"):
+            self.policy = opponent
+        elif hasattr(opponent, "act"):
+            if num_envs != 1:
+                raise ValueError("a Python bot keeps state per match: give it to SpacewarEnv "
+                                 "(one match), or give the vector env a compiled bot's name or a "
+                                 "policy with act_batch")
+            self.bot = opponent
+        else:
+            raise ValueError(f"opponent must be None, one of {', '.join(sorted(compiled_bots.KINDS))}, "
+                             f"a policy (.npz path or an object with act_batch) or a bot with act, "
+                             f"got {opponent!r}")
+
+    def codes(self, batch):
+        """Seat 1's codes for the coming frame (None when the batch decides them)."""
+        if self.policy is not None:
+            codes = np.asarray(self.policy.act_batch(batch.observations[:, 1]))
+            if codes.shape != (batch.game.n_matches,) or codes.dtype.kind not in "iu" \
+                    or codes.min() < 0 or codes.max() >= core.N_ACTIONS:
+                raise ValueError(f"the opponent policy's act_batch must give "
+                                 f"({batch.game.n_matches},) action codes in [0, "
+                                 f"{core.N_ACTIONS}), got {codes.dtype} {codes.shape}")
+            return codes
+        if self.bot is not None:
+            return np.array([action_code(self.bot.act(batch.game.observe(0, 1)))])
+        return None
+
+    def episode_started(self):
+        if self.bot is not None and hasattr(self.bot, "reset"):
+            self.bot.reset()
+
+
 class SpacewarVectorEnv(VectorEnv):
-    """``num_envs`` matches stepped together (see the module's text)."""
+    """``num_envs`` agents over compiled matches (see the module's text)."""
 
     metadata = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": []}
 
     def __init__(self, num_envs=1, opponent="random", rules=None, rounds=3, max_frames=20000,
-                 render_mode=None):
+                 render_mode=None, autoreset_mode="next_step", action_type="multi_discrete"):
         if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)) \
                 or num_envs < 1:
             raise ValueError(f"num_envs must be an int >= 1, got {num_envs!r}")
-        self.opponent = _check("opponent", opponent, OPPONENTS)
         if render_mode is not None:
-            raise ValueError(f"render_mode must be None for the vector env, got {render_mode!r}")
+            raise ValueError(f"render_mode must be None for the vector env (SpacewarEnv renders), "
+                             f"got {render_mode!r}")
+        if isinstance(autoreset_mode, AutoresetMode):
+            autoreset_mode = autoreset_mode.value
+        self.autoreset = _check("autoreset_mode", autoreset_mode, tuple(_AUTORESET))
+        self.metadata = {**type(self).metadata, "autoreset_mode": _AUTORESET[self.autoreset]}
         self.render_mode = None
         self.rules = Rules() if rules is None else rules
         self.rounds = rounds
         self.max_frames = max_frames
-        self.matches = int(num_envs) if opponent is not None else (int(num_envs) + 1) // 2
-        if opponent is None and num_envs % 2:
+        self.self_play = opponent is None
+        if self.self_play and num_envs % 2:
             raise ValueError(f"self-play (opponent=None) needs an even num_envs (two seats a "
                              f"match), got {num_envs}")
+        self._opponent = _Opponent(opponent, num_envs)
+        self.opponent = opponent
+        self.matches = int(num_envs) // 2 if self.self_play else int(num_envs)
         self.num_envs = int(num_envs)
-        self.single_action_space = action_space()
+        self.action_type = _check("action_type", action_type, ACTION_TYPES)
+        self.single_action_space = action_space(self.rules, action_type)
         self.single_observation_space = observation_space(self.rules)
         self.action_space = batch_space(self.single_action_space, self.num_envs)
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
         self._batch = None
-        self._seed = None
-        self._opponent_rng = None
-        self._codes = np.zeros((self.matches, 2), dtype=np.int64)
 
     def _new_batch(self, seed):
-        self._seed = int(np.random.SeedSequence(seed).entropy if seed is None else seed)
-        self._batch = LearningBatch(self.matches, self.rules, seed=self._seed, rounds=self.rounds,
-                                    frame_cap=self.max_frames)
-        self._opponent_rng = np.random.default_rng([self._seed, 1])
+        seed = int(np.random.SeedSequence(seed).entropy if seed is None else seed)
+        compiled = self._opponent.compiled
+        self._batch = LearningBatch(self.matches, self.rules, seed=seed, rounds=self.rounds,
+                                    frame_cap=self.max_frames, autoreset=self.autoreset,
+                                    opponents=(None, compiled if not self.self_play else None))
 
     def _view(self, array):
         """(M, 2, ...) per seat as the agent axis: seat 0 of each match, or both seats."""
-        if self.opponent is None:
+        if self.self_play:
             return array.reshape((2 * self.matches,) + array.shape[2:])
         return array[:, 0]
 
+    def _per_agent(self, flags):
+        return np.repeat(flags, 2) if self.self_play else flags.copy()
+
     def reset(self, *, seed=None, options=None):
-        if seed is not None or self._batch is None:
-            self._new_batch(seed)
+        mask = None if options is None else options.get("reset_mask")
+        if mask is not None:
+            if seed is not None:
+                raise ValueError("reset with a reset_mask keeps the batch's seed: give seed "
+                                 "without reset_mask")
+            if self._batch is None:
+                raise RuntimeError("call reset() without a reset_mask first")
+            self._batch.reset(self._match_mask(mask))
         else:
-            self._batch.pending[:] = True
-        self._codes[:] = 4  # turn none; what the resetting call ignores anyway
-        obs, _, _, _ = self._batch.step(self._codes)
-        return self._view(obs).copy(), {}
+            if seed is not None or self._batch is None:
+                self._new_batch(seed)
+            self._batch.reset()
+        self._opponent.episode_started()
+        return self._view(self._batch.observations).copy(), {}
+
+    def _match_mask(self, mask):
+        mask = np.asarray(mask)
+        if mask.shape != (self.num_envs,) or mask.dtype != np.bool_:
+            raise ValueError(f"reset_mask must be a bool array of shape ({self.num_envs},), got "
+                             f"{mask.dtype} {mask.shape}")
+        if self.self_play:
+            pairs = mask.reshape(self.matches, 2)
+            if (pairs[:, 0] != pairs[:, 1]).any():
+                raise ValueError("reset_mask must treat a match's two seats alike (agents 2m "
+                                 "and 2m + 1 are one match)")
+            return pairs[:, 0].copy()
+        return mask.copy()
 
     def step(self, actions):
-        if self._batch is None:
+        batch = self._batch
+        if batch is None:
             raise RuntimeError("call reset() before step()")
-        parts = np.asarray(actions, dtype=np.int64)
-        if not self.action_space.contains(parts):
-            raise ValueError(f"actions must be {self.num_envs} MultiDiscrete{list(NVEC)} actions, "
-                             f"got {np.asarray(actions).tolist()!r:.200}")
-        codes = codes_from_parts(parts)
-        if self.opponent is None:
-            self._codes[:] = codes.reshape(self.matches, 2)
+        actions = np.asarray(actions)
+        if not self.action_space.contains(actions.astype(np.int64, copy=False)
+                                          if actions.dtype.kind in "iu" else actions):
+            raise ValueError(f"actions must be {self.num_envs} actions of "
+                             f"{self.single_action_space}, got {actions.tolist()!r:.200}")
+        codes = actions.astype(np.int64) if self.action_type == "discrete" \
+            else codes_from_parts(actions)
+        full = np.empty((self.matches, 2), dtype=np.int64)
+        if self.self_play:
+            full[:] = codes.reshape(self.matches, 2)
         else:
-            self._codes[:, 0] = codes
-            if self.opponent == "idle":
-                self._codes[:, 1] = codes_from_parts(_NOOP_PARTS)[0]
-            else:
-                self._codes[:, 1] = self._opponent_rng.integers(0, 24, size=self.matches)
-        obs, rewards, terminated, truncated = self._batch.step(self._codes)
-        if self.opponent is None:
-            done_t = np.repeat(terminated, 2)
-            done_u = np.repeat(truncated, 2)
-        else:
-            done_t, done_u = terminated, truncated
+            full[:, 0] = codes
+            opponent = self._opponent.codes(batch)
+            full[:, 1] = core.NOOP if opponent is None else opponent
+        episodes = batch.episodes.copy()
+        obs, rewards, terminated, truncated = batch.step(full)
+        infos = {}
+        if self.autoreset == "same_step" and batch.ended.any():
+            infos = self._final_infos(batch)
+        if self._opponent.bot is not None and batch.episodes[0] != episodes[0]:
+            self._opponent.episode_started()
         return (self._view(obs).copy(), self._view(rewards).astype(np.float64),
-                done_t.copy(), done_u.copy(), {})
+                self._per_agent(terminated), self._per_agent(truncated), infos)
+
+    def _final_infos(self, batch):
+        """Gymnasium's same-step infos: the ended agents' last observations (object array)."""
+        ended = self._per_agent(batch.ended)
+        final = np.full(self.num_envs, None, dtype=object)
+        last = self._view(batch.final_observations)
+        for k in np.flatnonzero(ended):
+            final[k] = last[k].copy()
+        return {"final_obs": final, "_final_obs": ended, "final_info": {},
+                "_final_info": ended.copy()}
+
+    @property
+    def batch(self):
+        """The ``spacewar.learning.LearningBatch`` underneath (its ``game`` is the matches)."""
+        return self._batch
 
 
 class SpacewarEnv(gymnasium.Env):
     """One match against an opponent (see the module's text)."""
 
-    metadata = {"render_modes": []}
+    metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 60}
 
     def __init__(self, opponent="random", rules=None, rounds=3, max_frames=20000,
-                 render_mode=None):
-        _check("opponent", opponent, ("idle", "random"))
+                 render_mode=None, action_type="multi_discrete", size=480):
+        if opponent is None:
+            raise ValueError("SpacewarEnv needs an opponent (self-play: the vector env with "
+                             "opponent=None, or spacewar.envs.parallel_env())")
+        if render_mode not in (None, "rgb_array", "human"):
+            raise ValueError(f"render_mode must be None, 'rgb_array' or 'human', got "
+                             f"{render_mode!r}")
         self._vector = SpacewarVectorEnv(1, opponent=opponent, rules=rules, rounds=rounds,
-                                         max_frames=max_frames, render_mode=render_mode)
-        self.render_mode = None
+                                         max_frames=max_frames, action_type=action_type)
+        self.render_mode = render_mode
+        self.size = size
         self.action_space = self._vector.single_action_space
         self.observation_space = self._vector.single_observation_space
         self._ended = False
+        self._screen = None
+        self._effects = None
 
     def reset(self, *, seed=None, options=None):
         super().reset(seed=seed)
         obs, info = self._vector.reset(seed=seed, options=options)
         self._ended = False
+        self._start_drawing()
         return obs[0], info
 
     def step(self, action):
@@ -187,13 +332,77 @@ class SpacewarEnv(gymnasium.Env):
             raise RuntimeError("the episode has ended: call reset()")
         obs, rewards, terminated, truncated, info = self._vector.step(np.asarray(action)[None])
         self._ended = bool(terminated[0] or truncated[0])
+        if self._effects is not None:
+            self._effects.update(self.game.snapshot(0))
+        if self.render_mode == "human":
+            self.render()
         return obs[0], float(rewards[0]), bool(terminated[0]), bool(truncated[0]), info
+
+    @property
+    def game(self):
+        """The ``spacewar.game.Game`` of this env's match."""
+        return self._vector.batch.game
+
+    def _start_drawing(self):
+        self._effects = None
+        if self.render_mode is not None:
+            from .render import Effects
+
+            self._effects = Effects()
+            self._effects.update(self.game.snapshot(0))
+            if self.render_mode == "human":
+                self.render()
+
+    def render(self):
+        """``rgb_array``: the frame as (size, size, 3) uint8; ``human``: draws the window."""
+        if self.render_mode is None or self._vector.batch is None:
+            return None
+        from .render import render_frame, scene
+
+        snapshot = self.game.snapshot(0)
+        names = ("learner", _name(self._vector.opponent))
+        if self.render_mode == "rgb_array":
+            image = render_frame(snapshot, self.size, effects=self._effects, names=names,
+                                 rounds=self._vector.rounds)
+            return np.asarray(image.convert("RGB"))
+        self._draw_window(scene(snapshot, self.size, effects=self._effects, names=names,
+                                rounds=self._vector.rounds))
+        return None
+
+    def _draw_window(self, prims):
+        from .play import _paint, require_pygame
+
+        pygame = require_pygame()
+        if self._screen is None:
+            pygame.init()
+            self._screen = pygame.display.set_mode((self.size, self.size))
+            pygame.display.set_caption("Spacewar-v0")
+            self._clock = pygame.time.Clock()
+            self._fonts = {}
+        pygame.event.pump()
+        _paint(pygame, self._screen, prims, self._fonts)
+        pygame.display.flip()
+        self._clock.tick(self.metadata["render_fps"])
+
+    def close(self):
+        if self._screen is not None:
+            from .play import require_pygame
+
+            require_pygame().display.quit()
+            self._screen = None
+
+
+def _name(opponent):
+    if isinstance(opponent, str):
+        return os.path.basename(opponent)
+    return type(opponent).__name__
 
 
 AGENTS = ("ship_0", "ship_1")
 
 
-def parallel_env(rules=None, rounds=3, max_frames=20000, render_mode=None):
+def parallel_env(rules=None, rounds=3, max_frames=20000, render_mode=None,
+                 action_type="multi_discrete"):
     """One match with both seats as agents, a PettingZoo ``ParallelEnv`` (``pip install -e
     '.[rl]'``): agents ``"ship_0"`` and ``"ship_1"``, the spaces, rewards and episode end of
     the Gymnasium environments; both agents leave when the match ends."""
@@ -208,7 +417,8 @@ def parallel_env(rules=None, rounds=3, max_frames=20000, render_mode=None):
 
         def __init__(self):
             self._vector = SpacewarVectorEnv(2, opponent=None, rules=rules, rounds=rounds,
-                                             max_frames=max_frames, render_mode=render_mode)
+                                             max_frames=max_frames, render_mode=render_mode,
+                                             action_type=action_type)
             self.render_mode = None
             self.possible_agents = list(AGENTS)
             self.agents = []
@@ -232,7 +442,7 @@ def parallel_env(rules=None, rounds=3, max_frames=20000, render_mode=None):
             missing = [a for a in AGENTS if a not in actions]
             if missing:
                 raise ValueError(f"actions must hold one action per agent, missing {missing}")
-            parts = np.array([actions[a] for a in AGENTS], dtype=np.int64)
+            parts = np.array([actions[a] for a in AGENTS])
             obs, rewards, terminated, truncated, _ = self._vector.step(parts)
             out = ({a: obs[k] for k, a in enumerate(AGENTS)},
                    {a: float(rewards[k]) for k, a in enumerate(AGENTS)},
@@ -249,7 +459,11 @@ def parallel_env(rules=None, rounds=3, max_frames=20000, render_mode=None):
     return SpacewarParallelEnv()
 
 
+#: the compiled opponents' names, and None for self-play
+OPPONENTS = tuple(sorted(compiled_bots.KINDS)) + (None,)
+
 gymnasium.register("Spacewar-v0", entry_point=SpacewarEnv, vector_entry_point=SpacewarVectorEnv)
 
 __all__ = ["SpacewarEnv", "SpacewarVectorEnv", "parallel_env", "AGENTS", "action_space",
-           "observation_space", "codes_from_parts", "learning_length"]
+           "observation_space", "codes_from_parts", "learning_length", "ACTION_TYPES",
+           "OPPONENTS"]

@@ -28,7 +28,7 @@ from numba import prange
 from engine import space
 from engine.state import Model, State, Workspace
 
-from . import core
+from . import compiled_bots_interim as compiled_bots, core
 from .protocol import raw_layout
 from .rules import Rules
 
@@ -195,20 +195,39 @@ def episode_stream(base, m, episode):
     return z ^ (z >> np.uint64(31))
 
 
+#: autoreset modes (Gymnasium 1.x's ``AutoresetMode``): when a match whose episode ended is
+#: restarted. NEXT_STEP: at the next call, which returns its first observation with reward 0;
+#: SAME_STEP: at once, the ended episode's last observation kept in ``final_observations``;
+#: DISABLED: only when the caller asks (``LearningBatch.reset(mask)``).
+NEXT_STEP, SAME_STEP, DISABLED = 0, 1, 2
+AUTORESET_MODES = {"next_step": NEXT_STEP, "same_step": SAME_STEP, "disabled": DISABLED}
+
+#: a seat whose actions the caller gives (not one of ``compiled_bots.KINDS``)
+EXTERNAL = -1
+
+_BOT_MIX = np.uint64(0x2545F4914F6CDD1D)
+
+
 @jit(parallel=True)
 def step_learning(actions, pos, vel, mass, charge, radius, active, test, pinned, n, box, kinds,
                   params, param_offsets, indices, index_offsets, ship_gauges, ship_counters,
                   torp_life, match_state, rng, rules, drifts, kicks, doomed, scales, base,
-                  episodes, frame_cap, pending, observations, rewards, terminated, truncated):
-    """One step of every match for learning code, matches spread over the threads.
+                  episodes, frame_cap, mode, play, pending, observations, final_observations,
+                  rewards, terminated, truncated, seats, memory, bot_rng):
+    """One call for every match, matches spread over the threads in chunks.
 
-    A match whose episode ended at the previous call (``pending[m]``) is reset instead, with
-    the stream ``episode_stream(base, m, episodes[m])`` (Gymnasium's next-step autoreset):
-    its reward is 0 and its new first observation is written. Otherwise it plays a frame with
-    ``actions[m]``; ``rewards[m, seat]`` is +1 when the frame scored a round for the seat and
-    not for the enemy, -1 the other way, 0 otherwise; ``terminated[m]`` at the match's end,
-    ``truncated[m]`` at ``frame_cap`` frames (0: none). Every match's two seats are then
-    written into ``observations`` (M, 2, D) float32. Nothing is allocated per match."""
+    A match whose episode ended (``pending[m]``) is restarted, under NEXT_STEP or DISABLED,
+    instead of playing: episode ``episodes[m] + 1`` with the stream
+    ``episode_stream(base, m, episode)``, reward 0, its first observation written. Under
+    DISABLED the caller sets ``pending`` only for the matches it resets (and ``play`` False
+    restarts those without stepping the others). Otherwise a match plays a frame: a seat
+    with ``seats[s] >= 0`` is that compiled bot (``compiled_bots.decide``, its action
+    written into ``actions[m, s]``), the other takes ``actions[m, s]``. ``rewards[m, s]`` is
+    +1 when the frame scored a round for seat s and not for the enemy, -1 the other way, else
+    0; ``terminated[m]`` at the match's end, ``truncated[m]`` at ``frame_cap`` frames (0:
+    none). Under SAME_STEP an ended match writes its last observation into
+    ``final_observations[m]`` and restarts at once. Every match's two seats are then written
+    into ``observations`` (M, 2, D) float32. Nothing is allocated per match."""
     state = State(pos, vel, mass, charge, radius, active, test, pinned, n, box)
     model = Model(kinds, params, param_offsets, indices, index_offsets)
     work = Workspace(np.empty(0), np.empty(0, dtype=np.int64), False)
@@ -217,93 +236,188 @@ def step_learning(actions, pos, vel, mass, charge, radius, active, test, pinned,
     for c in prange(chunks):
         scratch = core.new_scratch(pos)
         for m in range(c * matches // chunks, (c + 1) * matches // chunks):
-            _learning_frame(m, actions, state, model, work, ship_gauges, ship_counters,
+            if pending[m]:
+                _restart(m, state, ship_gauges, ship_counters, torp_life, match_state, rng,
+                         rules, base, episodes, seats, memory, bot_rng)
+                pending[m] = False
+                rewards[m, 0] = 0.0
+                rewards[m, 1] = 0.0
+                terminated[m] = False
+                truncated[m] = False
+            elif play:
+                _play_frame(m, actions, state, model, work, ship_gauges, ship_counters,
                             torp_life, match_state, rng, rules, drifts, kicks, doomed, scratch,
-                            scales, base, episodes, frame_cap, pending, observations, rewards,
-                            terminated, truncated)
+                            frame_cap, seats, memory, bot_rng, rewards, terminated, truncated)
+                if terminated[m] or truncated[m]:
+                    if mode == SAME_STEP:
+                        _observe(m, state, ship_gauges, ship_counters, torp_life, match_state,
+                                 rules, scales, final_observations)
+                        _restart(m, state, ship_gauges, ship_counters, torp_life, match_state,
+                                 rng, rules, base, episodes, seats, memory, bot_rng)
+                    elif mode == NEXT_STEP:
+                        pending[m] = True
+            _observe(m, state, ship_gauges, ship_counters, torp_life, match_state, rules,
+                     scales, observations)
 
 
 @jit(inline="always")
-def _learning_frame(m, actions, state, model, work, ship_gauges, ship_counters, torp_life,
-                    match_state, rng, rules, drifts, kicks, doomed, scratch, scales, base,
-                    episodes, frame_cap, pending, observations, rewards, terminated, truncated):
-    """Match m's share of ``step_learning``."""
-    pos = state.pos
-    vel = state.vel
-    mass = state.mass
-    charge = state.charge
-    active = state.active
-    if True:
-        rewards[m, 0] = 0.0
-        rewards[m, 1] = 0.0
-        terminated[m] = False
-        truncated[m] = False
-        if pending[m]:
-            episodes[m] += 1
-            rng[m] = episode_stream(base, m, episodes[m])
-            core.reset_match(m, pos, vel, mass, charge, active, ship_gauges, ship_counters,
-                             torp_life, match_state, rules)
-            pending[m] = False
-        else:
-            s0 = match_state[m, core.SCORE0]
-            s1 = match_state[m, core.SCORE1]
-            core.step_match(m, actions, state, model, work, ship_gauges, ship_counters, torp_life,
-                            match_state, rng, rules, drifts, kicks, doomed, scratch)
-            d0 = match_state[m, core.SCORE0] - s0
-            d1 = match_state[m, core.SCORE1] - s1
-            if d0 > 0 and d1 == 0:
-                rewards[m, 0] = 1.0
-                rewards[m, 1] = -1.0
-            elif d1 > 0 and d0 == 0:
-                rewards[m, 0] = -1.0
-                rewards[m, 1] = 1.0
-            if match_state[m, core.OVER] == 1:
-                terminated[m] = True
-            elif frame_cap > 0 and match_state[m, core.FRAME] >= frame_cap:
-                truncated[m] = True
-            pending[m] = terminated[m] or truncated[m]
-        for seat in range(2):
-            write_learning(m, seat, pos, vel, charge, active, ship_gauges, ship_counters,
-                           torp_life, match_state, rules, scales, observations[m, seat])
+def _observe(m, state, ship_gauges, ship_counters, torp_life, match_state, rules, scales, out):
+    for seat in range(2):
+        write_learning(m, seat, state.pos, state.vel, state.charge, state.active, ship_gauges,
+                       ship_counters, torp_life, match_state, rules, scales, out[m, seat])
+
+
+@jit(inline="always")
+def _restart(m, state, ship_gauges, ship_counters, torp_life, match_state, rng, rules, base,
+             episodes, seats, memory, bot_rng):
+    """Match m's next episode: its own stream, fresh compiled bots."""
+    episodes[m] += 1
+    rng[m] = episode_stream(base, m, episodes[m])
+    core.reset_match(m, state.pos, state.vel, state.mass, state.charge, state.active,
+                     ship_gauges, ship_counters, torp_life, match_state, rules)
+    for s in range(2):
+        if seats[s] >= 0:
+            compiled_bots.reset_memory(m, s, memory)
+            bot_rng[m, s] = episode_stream(base ^ _BOT_MIX, m, 2 * episodes[m] + s)
+
+
+@jit(inline="always")
+def _play_frame(m, actions, state, model, work, ship_gauges, ship_counters, torp_life,
+                match_state, rng, rules, drifts, kicks, doomed, scratch, frame_cap, seats,
+                memory, bot_rng, rewards, terminated, truncated):
+    """One frame of match m and its rewards and ends (see ``step_learning``)."""
+    for s in range(2):
+        if seats[s] >= 0:
+            actions[m, s] = compiled_bots.decide(
+                seats[s], m, s, state.pos, state.vel, state.charge, state.active, ship_gauges,
+                ship_counters, torp_life, match_state, rules, memory, bot_rng)
+    s0 = match_state[m, core.SCORE0]
+    s1 = match_state[m, core.SCORE1]
+    core.step_match(m, actions, state, model, work, ship_gauges, ship_counters, torp_life,
+                    match_state, rng, rules, drifts, kicks, doomed, scratch)
+    d0 = match_state[m, core.SCORE0] - s0
+    d1 = match_state[m, core.SCORE1] - s1
+    r = 0.0
+    if d0 > 0 and d1 == 0:
+        r = 1.0
+    elif d1 > 0 and d0 == 0:
+        r = -1.0
+    rewards[m, 0] = r
+    rewards[m, 1] = -r
+    terminated[m] = match_state[m, core.OVER] == 1
+    truncated[m] = (not terminated[m]) and frame_cap > 0 and match_state[m, core.FRAME] >= frame_cap
 
 
 class LearningBatch:
     """M matches stepped for learning code: (M, 2) actions in; (M, 2, D) float32 observations,
     (M, 2) rewards and (M,) terminated and truncated flags out, from one compiled call.
 
-    Episodes restart themselves at the call after they end (Gymnasium's next-step autoreset),
-    match m's episode e playing the stream ``episode_stream(seed state, m, e)``: a run is
+    Match m's episode e plays the stream ``episode_stream(seed state, m, e)``, so a run is
     reproducible whatever the batch size or thread count. ``frame_cap`` truncates an episode
-    after that many frames (0: only the match's end ends it)."""
+    after that many frames (0: only the match's end ends it). ``autoreset``: ``"next_step"``
+    (Gymnasium's default), ``"same_step"`` (``final_observations`` and ``ended`` tell the
+    matches that ended) or ``"disabled"`` (``reset(mask)``). ``opponents``: per seat, None
+    for actions given to ``step``, or the name of a compiled bot (``compiled_bots.KINDS``)
+    that decides inside the compiled call."""
 
-    def __init__(self, matches, rules=None, seed=0, rounds=3, frame_cap=0):
+    def __init__(self, matches, rules=None, seed=0, rounds=3, frame_cap=0,
+                 autoreset="next_step", opponents=(None, None)):
         from .game import Game, seed_state
 
         if isinstance(frame_cap, bool) or not isinstance(frame_cap, (int, np.integer)) \
                 or frame_cap < 0:
             raise ValueError(f"frame_cap must be an int >= 0, got {frame_cap!r}")
+        if autoreset not in AUTORESET_MODES:
+            raise ValueError(f"autoreset must be one of {', '.join(AUTORESET_MODES)}, "
+                             f"got {autoreset!r}")
+        self.seats = seat_kinds(opponents)
         self.game = Game(rules, seeds=[0] * int(matches), rounds=rounds)  # streams set per episode
         self.rules = self.game.rules
         self.frame_cap = int(frame_cap)
+        self.mode = AUTORESET_MODES[autoreset]
         self.base = seed_state(seed)
-        self.episodes = np.full(self.game.n_matches, -1, dtype=np.int64)
-        self.pending = np.ones(self.game.n_matches, dtype=np.bool_)  # the first call resets
+        m = self.game.n_matches
+        self.episodes = np.full(m, -1, dtype=np.int64)
+        self.pending = np.ones(m, dtype=np.bool_)  # the first call starts every match
         self.scales = learning_scales(self.rules, rounds)
-        self.observations = np.zeros((self.game.n_matches, 2, learning_length(self.rules)),
-                                     dtype=np.float32)
-        self.rewards = np.zeros((self.game.n_matches, 2), dtype=np.float32)
-        self.terminated = np.zeros(self.game.n_matches, dtype=np.bool_)
-        self.truncated = np.zeros(self.game.n_matches, dtype=np.bool_)
+        shape = (m, 2, learning_length(self.rules))
+        self.observations = np.zeros(shape, dtype=np.float32)
+        self.final_observations = np.zeros(shape if self.mode == SAME_STEP else (0, 2, 0),
+                                           dtype=np.float32)
+        self.rewards = np.zeros((m, 2), dtype=np.float32)
+        self.terminated = np.zeros(m, dtype=np.bool_)
+        self.truncated = np.zeros(m, dtype=np.bool_)
+        self.memory = compiled_bots.new_memory(m)
+        self.bot_rng = np.zeros((m, 2), dtype=np.uint64)
+        self._codes = np.full((m, 2), core.NOOP, dtype=np.int64)
+        self._awaiting = np.zeros(m, dtype=np.bool_)  # ended, autoreset disabled, not yet reset
 
-    def step(self, actions):
-        """One step of every match (a reset for those whose episode ended last call)."""
+    @property
+    def ended(self):
+        """The matches whose episode ended at the last call (terminated or truncated)."""
+        return self.terminated | self.truncated
+
+    def step(self, actions=None):
+        """One frame of every match (a restart for those whose episode ended at the last call,
+        under next-step autoreset). ``actions`` (M, 2) codes: the compiled seats' entries are
+        ignored, and may be left out (None) when both seats are compiled bots."""
+        if self._awaiting.any():
+            ended = np.flatnonzero(self._awaiting)
+            raise RuntimeError(f"matches {ended[:10].tolist()} ended (autoreset disabled): reset "
+                               f"them with reset(mask) before stepping")
+        if actions is not None:
+            self._codes[:] = self.game._encode(actions)
+        elif (self.seats < 0).any():
+            raise ValueError("actions are needed for the seats without a compiled bot")
+        out = self._call(True)
+        if self.mode == DISABLED:
+            self._awaiting |= self.ended
+        return out
+
+    def reset(self, mask=None):
+        """Restart the matches of ``mask`` ((M,) bool; all if None) without stepping the
+        others; returns the observations."""
+        if mask is None:
+            mask = np.ones_like(self.pending)
+        else:
+            mask = np.asarray(mask)
+            if mask.shape != self.pending.shape or mask.dtype != np.bool_:
+                raise ValueError(f"mask must be a bool array of shape {self.pending.shape}, got "
+                                 f"{mask.dtype} {mask.shape}")
+        self.pending |= mask
+        self._awaiting &= ~mask
+        self._call(False)
+        return self.observations
+
+    def _call(self, play):
         game = self.game
-        codes = game._encode(actions)
         game._sync_with_batch()
-        step_learning(codes, *game._frame_arguments, self.scales, self.base, self.episodes,
-                      self.frame_cap, self.pending, self.observations, self.rewards,
-                      self.terminated, self.truncated)
+        step_learning(self._codes, *game._frame_arguments, self.scales, self.base, self.episodes,
+                      self.frame_cap, self.mode, play, self.pending, self.observations,
+                      self.final_observations, self.rewards, self.terminated, self.truncated,
+                      self.seats, self.memory, self.bot_rng)
         return self.observations, self.rewards, self.terminated, self.truncated
+
+    @property
+    def actions(self):
+        """The (M, 2) action codes of the last frame, the compiled bots' included."""
+        return self._codes
+
+
+def seat_kinds(opponents):
+    """(2,) int64: each seat's compiled bot kind, ``EXTERNAL`` for None."""
+    if not isinstance(opponents, (tuple, list)) or len(opponents) != 2:
+        raise ValueError(f"opponents must be a pair (one per seat), got {opponents!r}")
+    kinds = []
+    for name in opponents:
+        if name is None:
+            kinds.append(EXTERNAL)
+        elif name in compiled_bots.KINDS:
+            kinds.append(compiled_bots.KINDS[name])
+        else:
+            raise ValueError(f"opponent must be None or one of "
+                             f"{', '.join(sorted(compiled_bots.KINDS))}, got {name!r}")
+    return np.array(kinds, dtype=np.int64)
 
 
 def learning_vector(raw, rules, rounds):
@@ -345,4 +459,5 @@ def learning_vector(raw, rules, rounds):
 
 __all__ = ["learning_layout", "learning_length", "learning_scales", "learning_vector",
            "write_learning", "write_all_learning", "episode_stream", "step_learning",
-           "LearningBatch"]
+           "LearningBatch", "seat_kinds", "AUTORESET_MODES", "NEXT_STEP", "SAME_STEP", "DISABLED",
+           "EXTERNAL"]

@@ -5,6 +5,7 @@ import pytest
 gymnasium = pytest.importorskip("gymnasium")
 
 import spacewar.envs as envs  # noqa: E402  (registers Spacewar-v0)
+from spacewar.bots.idle import Idle  # noqa: E402
 from spacewar.learning import learning_length  # noqa: E402
 from spacewar.rules import Rules  # noqa: E402
 
@@ -60,13 +61,19 @@ def test_a_seed_fixes_the_run():
 
 
 def test_bad_arguments_are_refused():
-    with pytest.raises(ValueError, match="opponent must be one of 'idle', 'random', None"):
-        envs.SpacewarVectorEnv(2, opponent="chaser")
+    with pytest.raises(ValueError, match="opponent must be None, one of .*idle.*random"):
+        envs.SpacewarVectorEnv(2, opponent="nobody")
+    with pytest.raises(ValueError, match="a Python bot keeps state per match"):
+        envs.SpacewarVectorEnv(2, opponent=Idle())
+    with pytest.raises(ValueError, match="autoreset_mode must be one of"):
+        envs.SpacewarVectorEnv(2, autoreset_mode="sometimes")
+    with pytest.raises(ValueError, match="action_type must be one of"):
+        envs.SpacewarVectorEnv(2, action_type="continuous")
     vec = envs.SpacewarVectorEnv(2, opponent="idle")
     with pytest.raises(RuntimeError, match="call reset"):
         vec.step(np.zeros((2, 4), dtype=np.int64))
     vec.reset(seed=0)
-    with pytest.raises(ValueError, match="actions must be 2 MultiDiscrete"):
+    with pytest.raises(ValueError, match="actions must be 2 actions of MultiDiscrete"):
         vec.step(np.full((2, 4), 5))
     np.testing.assert_array_equal(envs.codes_from_parts([[2, 1, 1, 0]]), [2 + 3 + 6])
 

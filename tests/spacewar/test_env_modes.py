@@ -1,0 +1,171 @@
+"""The vector env's autoreset modes, action types, opponents and rendering."""
+import numpy as np
+import pytest
+
+gymnasium = pytest.importorskip("gymnasium")
+
+import spacewar.envs as envs  # noqa: E402  (registers Spacewar-v0)
+from spacewar.bots.chaser import Chaser  # noqa: E402
+from spacewar.rules import Rules  # noqa: E402
+
+CAP = 40  # frames: episodes end by truncation, at a known step
+
+
+def _lockstep(mode, steps, num_envs=3, seed=11):
+    """The same seeded run under next-step autoreset and under ``mode``, step by step."""
+    ref = envs.SpacewarVectorEnv(num_envs, opponent="random", max_frames=CAP)
+    other = envs.SpacewarVectorEnv(num_envs, opponent="random", max_frames=CAP,
+                                   autoreset_mode=mode)
+    actions = np.random.default_rng(0).integers(0, [3, 2, 2, 2], size=(steps, num_envs, 4))
+    return ref, other, actions, ref.reset(seed=seed)[0], other.reset(seed=seed)[0]
+
+
+def test_same_step_autoreset_returns_the_next_episode_and_the_final_observation():
+    ref, same, actions, o_ref, o_same = _lockstep("same_step", 2 * CAP + 4)
+    assert same.metadata["autoreset_mode"] == gymnasium.vector.AutoresetMode.SAME_STEP
+    np.testing.assert_array_equal(o_ref, o_same)
+    k = 0
+    ends = 0
+    for a in actions[:CAP]:
+        o_ref, r_ref, t_ref, u_ref, _ = ref.step(a)
+        o_same, r_same, t_same, u_same, info = same.step(a)
+        np.testing.assert_array_equal(r_ref, r_same)
+        np.testing.assert_array_equal(u_ref, u_same)
+        if u_ref.any():
+            ends += 1
+            # the ended episode's last observation is what next-step mode shows now ...
+            assert info["_final_obs"].tolist() == u_ref.tolist()
+            for e in np.flatnonzero(u_ref):
+                np.testing.assert_array_equal(info["final_obs"][e], o_ref[e])
+            # ... and same-step already shows the next episode, which next-step shows next
+            o_ref2, r_ref2, *_ = ref.step(actions[CAP])
+            np.testing.assert_array_equal(o_ref2, o_same)
+            assert (r_ref2 == 0).all()
+        else:
+            np.testing.assert_array_equal(o_ref, o_same)
+            assert info == {}
+        k += 1
+    assert ends == 1 and k == CAP
+
+
+def test_disabled_autoreset_waits_for_a_reset_mask():
+    ref, off, actions, _, _ = _lockstep("disabled", CAP + 1)
+    for a in actions[:CAP]:
+        ref.step(a)
+        obs, _, _, truncated, _ = off.step(a)
+    assert truncated.all()
+    with pytest.raises(RuntimeError, match="ended .*reset them"):
+        off.step(actions[CAP])
+    mask = np.array([True, False, True])
+    first = ref.step(actions[CAP])[0]  # next-step mode's restart: each episode's first frame
+    again, _ = off.reset(options={"reset_mask": mask})
+    np.testing.assert_array_equal(again[mask], first[mask])
+    np.testing.assert_array_equal(again[~mask], obs[~mask])  # untouched
+    with pytest.raises(RuntimeError, match=r"matches \[1\] ended"):
+        off.step(actions[CAP])
+    again, _ = off.reset(options={"reset_mask": ~mask})
+    np.testing.assert_array_equal(again, first)
+    off.step(actions[CAP])  # all restarted: stepping is allowed again
+    with pytest.raises(ValueError, match="reset_mask must be a bool array of shape"):
+        off.reset(options={"reset_mask": np.ones(2, dtype=bool)})
+
+
+def test_the_flat_discrete_actions_play_the_same_game():
+    multi = envs.SpacewarVectorEnv(4, opponent="random", max_frames=300)
+    flat = envs.SpacewarVectorEnv(4, opponent="random", max_frames=300, action_type="discrete")
+    assert flat.single_action_space == gymnasium.spaces.Discrete(24)
+    a, _ = multi.reset(seed=5)
+    b, _ = flat.reset(seed=5)
+    parts = np.random.default_rng(1).integers(0, [3, 2, 2, 2], size=(200, 4, 4))
+    for p in parts:
+        a = multi.step(p)[0]
+        b = flat.step(envs.codes_from_parts(p))[0]
+        np.testing.assert_array_equal(a, b)
+
+
+def test_the_electric_mode_has_a_flip_action_that_reverses_the_charge():
+    rules = Rules(mode="electric")
+    env = envs.SpacewarEnv(opponent="idle", rules=rules, max_frames=100)
+    assert env.action_space == gymnasium.spaces.MultiDiscrete([3, 2, 2, 2, 2])
+    assert envs.action_space(rules, "discrete") == gymnasium.spaces.Discrete(48)
+    names = envs.learning_layout(rules)
+    sign = names.index("me.charge_sign")
+    obs, _ = env.reset(seed=0)
+    before = obs[sign]
+    assert before != 0.0
+    obs, *_ = env.step(np.array([1, 0, 0, 0, 1]))
+    assert obs[sign] == -before
+    obs, *_ = env.step(np.array([1, 0, 0, 0, 1]))  # cooling down: no second flip yet
+    assert obs[sign] == -before
+
+
+class _Constant:
+    """A batch policy that always answers one action code."""
+
+    def __init__(self, code):
+        self.code = code
+        self.calls = []
+
+    def act_batch(self, obs):
+        self.calls.append(obs.copy())
+        return np.full(len(obs), self.code, dtype=np.int64)
+
+
+def test_a_batch_policy_plays_every_match_from_seat_ones_observations():
+    policy = _Constant(3)  # thrust only
+    vec = envs.SpacewarVectorEnv(5, opponent=policy, max_frames=200)
+    obs, _ = vec.reset(seed=2)
+    for _ in range(3):
+        seat_one = vec.batch.observations[:, 1].copy()
+        vec.step(np.ones((5, 4), dtype=np.int64) * [1, 0, 0, 0])
+        np.testing.assert_array_equal(policy.calls[-1], seat_one)  # what seat 1 saw
+    assert (vec.batch.actions[:, 1] == 3).all()
+    assert len(policy.calls) == 3 and policy.calls[0].dtype == np.float32
+    bad = envs.SpacewarVectorEnv(2, opponent=_Constant(99), max_frames=50)
+    bad.reset(seed=0)
+    with pytest.raises(ValueError, match="act_batch must give"):
+        bad.step(np.ones((2, 4), dtype=np.int64))
+
+
+def test_a_python_bot_object_can_be_the_single_envs_opponent():
+    class Counting(Chaser):
+        resets = 0
+
+        def reset(self):
+            Counting.resets += 1
+            super().reset()
+
+    env = envs.SpacewarEnv(opponent=Counting(), max_frames=60)
+    env.reset(seed=1)
+    for _ in range(60):
+        *_, terminated, truncated, _ = env.step(env.action_space.sample())
+    assert truncated
+    env.reset()
+    assert Counting.resets == 2
+
+
+def test_rgb_array_rendering_draws_the_match():
+    pytest.importorskip("PIL")
+    from gymnasium.utils.env_checker import check_env
+
+    env = envs.SpacewarEnv(opponent="random", max_frames=200, render_mode="rgb_array")
+    check_env(env)
+    env.reset(seed=0)
+    first = env.render()
+    assert first.shape == (480, 480, 3) and first.dtype == np.uint8 and first.any()
+    for _ in range(30):
+        env.step(np.array([2, 1, 1, 0]))
+    assert (env.render() != first).any()
+
+
+def test_human_rendering_opens_the_window(monkeypatch):
+    pytest.importorskip("pygame")
+    monkeypatch.setenv("SDL_VIDEODRIVER", "dummy")
+    env = envs.SpacewarEnv(opponent="idle", max_frames=20, render_mode="human", size=240)
+    env.metadata = {**env.metadata, "render_fps": 0}  # no waiting in a test
+    env.reset(seed=0)
+    for _ in range(5):
+        env.step(np.array([1, 1, 0, 0]))
+    assert env._screen is not None and env._screen.get_size() == (240, 240)
+    env.close()
+    assert env._screen is None
