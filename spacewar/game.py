@@ -171,6 +171,20 @@ class Game:
         self._sync_with_batch()
         core.step_all(self._actions, *self._frame_arguments)
 
+    def _step_codes(self, codes):
+        """``step`` with (M, 2) int64 action codes the caller has already checked (the match
+        loop's, which come from ``protocol.action_code``): no conversion, no checks."""
+        self._sync_with_batch()
+        core.step_all(codes, *self._frame_arguments)
+
+    def _write_raw(self, m, seat, out):
+        """``raw_observation(m, seat, out)`` for a caller that owns a right ``out``."""
+        state = self.state
+        core.write_observation(m, seat, state.pos, state.vel, state.charge, state.active,
+                               self.ship_gauges, self.ship_counters, self.torp_life,
+                               self.match_state, self.rules_vector, out)
+        return out
+
     def _encode(self, actions):
         if isinstance(actions, np.ndarray) and actions.dtype.kind in "iu":
             codes = actions

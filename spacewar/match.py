@@ -92,11 +92,12 @@ def play_match(p1, p2, seed=0, rounds=5, rules=None, budget=DEFAULT_BUDGET,
                 forfeits[s] = True
         actions = np.full((1, 2), core.NOOP, dtype=np.int64)
         raws = [np.empty(raw_length(rules)) for _ in seats]  # every seat copies what it keeps
-        while not game.over[0] and not any(forfeits):
-            frame = int(game.match_state[0, core.FRAME])
+        match_state = game.match_state
+        while not match_state[0, core.OVER] and not any(forfeits):
+            frame = int(match_state[0, core.FRAME])
             kinds = [0, 0]
             for s, seat in enumerate(seats):
-                code, fault = seat.act(game.raw_observation(0, s, out=raws[s]))
+                code, fault = seat.act(game._write_raw(0, s, raws[s]))
                 actions[0, s] = code
                 if fault is not None:
                     faults[s].add(frame, *fault)
@@ -107,7 +108,7 @@ def play_match(p1, p2, seed=0, rounds=5, rules=None, budget=DEFAULT_BUDGET,
                 fault_codes += bytes(kinds)
             if any(forfeits):
                 break
-            game.step(actions)
+            game._step_codes(actions)  # codes from protocol.action_code: already checked
             if record:
                 history += bytes((int(actions[0, 0]), int(actions[0, 1])))
             if on_frame is not None:

@@ -189,13 +189,23 @@ def _frozen(array):
     return array
 
 
+def _made(cls, fields):
+    """An instance of the frozen dataclass ``cls`` holding ``fields`` (all of them), without
+    its generated ``__init__``, which sets each field through ``object.__setattr__`` and was
+    most of the cost of an observation (one is made per seat per frame)."""
+    obj = object.__new__(cls)
+    obj.__dict__.update(fields)
+    return obj
+
+
 def _ship_from_raw(r):
     """A Ship from its 15 raw numbers ``r`` (a read-only array: pos and vel are views of it)."""
     x = r.tolist()
-    return Ship(pos=r[0:2], vel=r[2:4], heading=x[4], angular_velocity=x[5], fuel=x[6],
-                torpedoes=int(x[7]), hyperspace=int(x[8]), alive=bool(x[9]),
-                in_hyperspace=bool(x[10]), reload=int(x[11]), hyperspace_recharge=int(x[12]),
-                charge=x[13], flip_cooldown=int(x[14]))
+    return _made(Ship, {"pos": r[0:2], "vel": r[2:4], "heading": x[4], "angular_velocity": x[5],
+                        "fuel": x[6], "torpedoes": int(x[7]), "hyperspace": int(x[8]),
+                        "alive": bool(x[9]), "in_hyperspace": bool(x[10]), "reload": int(x[11]),
+                        "hyperspace_recharge": int(x[12]), "charge": x[13],
+                        "flip_cooldown": int(x[14])})
 
 
 def _ship_vector(x, scales):
@@ -212,22 +222,38 @@ def observation_from_raw(raw, rules, shown_rules=None):
     raw = np.asarray(raw, dtype=np.float64)
     if raw.shape != (raw_length(rules),):
         raise ValueError(f"raw observation must have shape ({raw_length(rules)},), got {raw.shape}")
+    raw = _frozen(raw.copy())  # the bot's own copy: pos, vel and star_pos are views of it
     h = raw[:_NH].tolist()
-    ships = _frozen(raw[_NH:_NH + 2 * _NS].copy())
-    me, enemy = _ship_from_raw(ships[:_NS]), _ship_from_raw(ships[_NS:])
-    slots = raw[_NH + 2 * _NS:].reshape(-1, _NT)
-    live = _frozen(slots[slots[:, 0] != 0.0])
-    torpedoes = tuple(Torpedo(pos=row[1:3], vel=row[3:5], mine=bool(x[5]), ttl=int(x[6]),
-                              charge=x[7]) for row, x in zip(live, live.tolist()))
-    return Observation(me=me, enemy=enemy, torpedoes=torpedoes,
-                       star_pos=_frozen(np.array(h[8:10])), star_mu=h[6], star_capture=h[7],
-                       frame=int(h[0]), round_frame=int(h[1]), round=int(h[2]),
-                       score=(int(h[3]), int(h[4])), seat=int(h[5]),
-                       rules=rules if shown_rules is None else shown_rules,
-                       _raw=_frozen(raw.copy()), _scales=_scales(rules))
+    me = _ship_from_raw(raw[_NH:_NH + _NS])
+    enemy = _ship_from_raw(raw[_NH + _NS:_NH + 2 * _NS])
+    first = _NH + 2 * _NS
+    torpedoes = []
+    for k in np.flatnonzero(raw[first::_NT]).tolist():  # the live slots, in slot order
+        a = first + k * _NT
+        x = raw[a:a + _NT].tolist()
+        torpedoes.append(_made(Torpedo, {"pos": raw[a + 1:a + 3], "vel": raw[a + 3:a + 5],
+                                         "mine": bool(x[5]), "ttl": int(x[6]), "charge": x[7]}))
+    return _made(Observation, {
+        "me": me, "enemy": enemy, "torpedoes": tuple(torpedoes), "star_pos": raw[8:10],
+        "star_mu": h[6], "star_capture": h[7], "frame": int(h[0]), "round_frame": int(h[1]),
+        "round": int(h[2]), "score": (int(h[3]), int(h[4])), "seat": int(h[5]),
+        "rules": rules if shown_rules is None else shown_rules, "_vector": None, "_raw": raw,
+        "_scales": _scales(rules)})
 
 
 def _scales(rules):
+    """``_scale_numbers(rules)``, kept for the rules object last asked about (a match asks
+    with the same one every frame, and hashing the rules costs more than the numbers)."""
+    global _LAST_SCALES
+    if _LAST_SCALES[0] is not rules:
+        _LAST_SCALES = (rules, _scale_numbers(rules))
+    return _LAST_SCALES[1]
+
+
+_LAST_SCALES = (None, None)
+
+
+def _scale_numbers(rules):
     """The numbers of the rules that scale the learning vector: plain floats, so that an
     observation holds no reference to the rules that decoded it."""
     return (max(rules.fuel, 1e-300), float(rules.torpedoes), float(max(rules.hyperspace_jumps, 1)),

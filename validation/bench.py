@@ -460,14 +460,35 @@ def bench_batch(systems=4096, slots=66, repeats=5):
             "bit_identical_to_separate": bool(same)}
 
 
-# -- 8. Spacewar for learning code: spacewar.learning.LearningBatch ---------------------------
-def bench_learning(matches=4096, frames=50, repeats=3):
-    """Match-frames per second of ``LearningBatch.step`` (random actions; observations,
-    rewards, terminations and resets included), at 1 thread and at every thread, with the
-    results compared between the two."""
-    from spacewar.learning import LearningBatch
+# -- 8. Spacewar for learning code: spacewar.learning and spacewar.envs -----------------------
+def _vector_env_rate(opponent, matches, frames, repeats, seed=1):
+    """Match-frames per second of ``SpacewarVectorEnv.step`` with random actions (the env's
+    own checks, the conversion of actions, observations, rewards and flags included) and
+    the final observations, so that runs at different thread counts can be compared."""
+    from spacewar.envs import SpacewarVectorEnv
+
+    env = SpacewarVectorEnv(matches, opponent=opponent, max_frames=3000)
+    env.reset(seed=seed)
+    actions = np.random.default_rng(0).integers(0, [3, 2, 2, 2], size=(frames, matches, 4))
+    env.step(actions[0])
+    best = math.inf
+    for _ in range(repeats):
+        start = time.perf_counter()
+        for f in range(frames):
+            obs = env.step(actions[f])[0]
+        best = min(best, time.perf_counter() - start)
+    return matches * frames / best, obs
+
+
+def bench_learning(matches=4096, frames=50, repeats=3, opponents=("random", "chaser")):
+    """Match-frames per second, at 1 thread and at every thread, with the results compared
+    between the two: ``LearningBatch.step`` (random actions; observations, rewards,
+    terminations and resets included) and ``SpacewarVectorEnv.step`` against each compiled
+    opponent (the learner's actions random)."""
+    from spacewar.learning import LearningBatch, compiled_bots
 
     codes = np.random.default_rng(0).integers(0, 24, size=(frames, matches, 2))
+    opponents = [o for o in opponents if o in compiled_bots.KINDS]
     rows, finals = {}, []
     for count in _each_thread_count():
         batch = LearningBatch(matches, seed=1, rounds=3, frame_cap=3000)
@@ -478,10 +499,44 @@ def bench_learning(matches=4096, frames=50, repeats=3):
             for f in range(frames):
                 batch.step(codes[f])
             best = min(best, time.perf_counter() - start)
-        rows[str(count)] = {"match_frames_per_second": matches * frames / best}
-        finals.append(batch.observations.copy())
-    same = all(np.array_equal(finals[0], other) for other in finals[1:])
-    return {"matches": matches, "threads": rows, "identical_across_threads": bool(same)}
+        row = {"match_frames_per_second": matches * frames / best}
+        final = [batch.observations.copy()]
+        for opponent in opponents:
+            rate, obs = _vector_env_rate(opponent, matches, frames, repeats)
+            row[f"vector_env_vs_{opponent}_match_frames_per_second"] = rate
+            final.append(obs)
+        rows[str(count)] = row
+        finals.append(final)
+    same = all(np.array_equal(a, b) for other in finals[1:] for a, b in zip(finals[0], other))
+    return {"matches": matches, "opponents": opponents, "threads": rows,
+            "identical_across_threads": bool(same), "harness": bench_harness()}
+
+
+def bench_harness(rounds=1, repeats=3):
+    """One match between two idle Python bots: the harness's own cost per frame, i.e. the
+    match's wall time per frame less the two bots' ``act`` calls (timed alone on the same
+    observations)."""
+    from spacewar import Game, Rules
+    from spacewar.bots.idle import Idle
+    from spacewar.match import play_match
+
+    play_match("idle", "idle", seed=1, rounds=1)  # compiled code loaded
+    per_frame = math.inf
+    for _ in range(repeats):
+        result, _, timing = play_match("idle", "idle", seed=1, rounds=rounds)
+        per_frame = min(per_frame, timing["wall_seconds"] / result["steps"])
+    game = Game(Rules(), seeds=[1], rounds=rounds)
+    bot = Idle()
+    obs = game.observe(0, 0)
+    calls = 20000
+    act = math.inf
+    for _ in range(repeats):
+        start = time.perf_counter()
+        for _ in range(calls):
+            bot.act(obs)
+        act = min(act, (time.perf_counter() - start) / calls)
+    return {"frames": result["steps"], "seconds_per_frame": per_frame,
+            "act_seconds": act, "harness_seconds_per_frame": per_frame - 2 * act}
 
 
 # -- the machine --------------------------------------------------------------------------------
@@ -603,6 +658,18 @@ def targets(r):
         rows.append(("step cost follows the declared terms",
                      ", ".join(f"{x:.2f}x" for x in rel) + " for 1, 2, 4 terms",
                      all(b >= a * 0.95 for a, b in zip(rel, rel[1:]))))
+    if "learning" in r:
+        g = r["learning"]
+        fastest = max(g["threads"].values(), key=lambda row: row["match_frames_per_second"])
+        for opponent, goal in (("random", 2e6), ("chaser", 1e6)):
+            key = f"vector_env_vs_{opponent}_match_frames_per_second"
+            if key in fastest:
+                rows.append((f"SpacewarVectorEnv.step vs {opponent}, {g['matches']} matches: "
+                             f"at least {goal:.0e} match-frames/s", f"{fastest[key]:.2e}",
+                             fastest[key] >= goal))
+        h = g["harness"]["harness_seconds_per_frame"]
+        rows.append(("one match of two idle Python bots: the harness's own cost at most 10 us "
+                     "per frame", f"{h * 1e6:.1f} us", h <= 10e-6))
     return rows
 
 
@@ -686,10 +753,18 @@ def format_report(r):
     if "learning" in r:
         g = r["learning"]
         same = "identical" if g["identical_across_threads"] else "DIFFERENT"
-        lines.append(f"\n8. learning batch: {g['matches']} matches, observations and rewards included "
-                     f"({same} at every thread count): " + "; ".join(
-                         f"{count} thread(s) {row['match_frames_per_second']:.3e} match-frames/s"
-                         for count, row in g["threads"].items()))
+        lines.append(f"\n8. learning: {g['matches']} matches, observations and rewards included "
+                     f"({same} at every thread count), match-frames/s")
+        for count, row in g["threads"].items():
+            lines.append(f"  {count} thread(s): LearningBatch.step "
+                         f"{row['match_frames_per_second']:.3e}" + "".join(
+                             f"; SpacewarVectorEnv.step vs {o} "
+                             f"{row[f'vector_env_vs_{o}_match_frames_per_second']:.3e}"
+                             for o in g["opponents"]))
+        h = g["harness"]
+        lines.append(f"  one match of two idle Python bots: {h['seconds_per_frame'] * 1e6:.1f} us "
+                     f"per frame, of which the bots' act {2 * h['act_seconds'] * 1e6:.2f} us: the "
+                     f"harness's own cost {h['harness_seconds_per_frame'] * 1e6:.1f} us per frame")
     if targets(r):
         lines.append("\ntargets:")
         for name, measured, met in targets(r):
@@ -793,14 +868,26 @@ def format_markdown(r, command):
         out.append("")
     if "learning" in r:
         g = r["learning"]
-        out += [f"## 8. Spacewar for learning code (`spacewar.learning.LearningBatch`, "
-                f"{g['matches']} matches)", "",
+        opponents = g.get("opponents", [])
+        out += [f"## 8. Spacewar for learning code ({g['matches']} matches)", "",
                 "Random actions; every match's two egocentric observations, rewards, "
-                "terminations and resets included in the compiled step. Results "
+                "terminations and resets included in the compiled step; "
+                "`SpacewarVectorEnv.step` also includes its action checks and conversion and "
+                "the compiled opponent's decisions. Results "
                 + ("identical" if g["identical_across_threads"] else "**different**")
-                + " at every thread count.", "", "| threads | match-frames/s |", "|---|---|"]
-        out += [f"| {count} | {row['match_frames_per_second']:.3e} |"
-                for count, row in g["threads"].items()]
+                + " at every thread count. Match-frames per second:", "",
+                "| threads | `LearningBatch.step` | "
+                + " | ".join(f"`SpacewarVectorEnv.step` vs {o}" for o in opponents) + " |",
+                "|---|---|" + "---|" * len(opponents)]
+        out += [f"| {count} | {row['match_frames_per_second']:.3e} | " + " | ".join(
+                    f"{row[f'vector_env_vs_{o}_match_frames_per_second']:.3e}"
+                    for o in opponents) + " |" for count, row in g["threads"].items()]
+        h = g.get("harness")
+        if h:
+            out += ["", f"One match of two idle Python bots ({h['frames']} frames): "
+                    f"{h['seconds_per_frame'] * 1e6:.1f} us per frame, of which the two bots' "
+                    f"`act` {2 * h['act_seconds'] * 1e6:.2f} us: the harness's own cost is "
+                    f"{h['harness_seconds_per_frame'] * 1e6:.1f} us per frame."]
         out.append("")
     return "\n".join(out)
 
