@@ -247,27 +247,32 @@ def _hit(pos, m, a, b, box, diamond):
 
 
 @jit()
-def _collisions(m, pos, vel, active, ship_counters, torp_life, match_state, rules, doomed_rows):
-    """Torpedoes and ships that touch, and what the star captures; ``doomed_rows`` (M, bodies)
-    is scratch, so a frame allocates nothing."""
+def _collisions(m, pos, vel, active, ship_counters, torp_life, match_state, rules, marks):
+    """Torpedoes and ships that touch, and what the star captures. ``marks`` (M, 2, bodies)
+    int64 is scratch, so a frame allocates nothing: row 0 lists the live bodies (the pair
+    test then visits only those, a handful of a match's 66 slots), row 1 flags the doomed."""
     n = pos.shape[2]
     box = rules[R_HITBOX]
     diamond = rules[R_DIAMOND]
-    doomed = doomed_rows[m]
+    live = 0
     for b in range(n):
-        doomed[b] = False
-    for a in range(n):
-        if not active[m, a]:
-            continue
-        for b in range(a + 1, n):
-            if active[m, b] and _hit(pos, m, a, b, box, diamond):
-                doomed[a] = True
-                doomed[b] = True
+        marks[m, 1, b] = 0
+        if active[m, b]:
+            marks[m, 0, live] = b
+            live += 1
+    for i in range(live):
+        a = marks[m, 0, i]
+        for j in range(i + 1, live):
+            b = marks[m, 0, j]
+            if _hit(pos, m, a, b, box, diamond):
+                marks[m, 1, a] = 1
+                marks[m, 1, b] = 1
     # the star: ships (and, where they feel it, torpedoes) within its capture radius
     if rules[R_STAR] > 0.0:
         r2 = rules[R_CAPTURE] ** 2
-        for b in range(n):
-            if not active[m, b] or (b >= 2 and rules[R_TORP_STAR] == 0.0):
+        for i in range(live):
+            b = marks[m, 0, i]
+            if b >= 2 and rules[R_TORP_STAR] == 0.0:
                 continue
             if pos[m, 0, b] ** 2 + pos[m, 1, b] ** 2 < r2:
                 if b < 2 and rules[R_STAR_KILLS] == 0.0:
@@ -276,9 +281,10 @@ def _collisions(m, pos, vel, active, ship_counters, torp_life, match_state, rule
                     vel[m, 0, b] = 0.0
                     vel[m, 1, b] = 0.0
                 else:
-                    doomed[b] = True
-    for b in range(n):
-        if doomed[b]:
+                    marks[m, 1, b] = 1
+    for i in range(live):
+        b = marks[m, 0, i]
+        if marks[m, 1, b]:
             if b < 2:
                 _kill_ship(m, b, active, ship_counters, match_state[m, FRAME])
             else:
@@ -318,7 +324,7 @@ def _round_logic(m, pos, vel, mass, charge, active, ship_gauges, ship_counters, 
 
 @jit()
 def step_match(m, actions, state, model, work, ship_gauges, ship_counters, torp_life,
-               match_state, rng, rules, drifts, kicks, doomed, scratch):
+               match_state, rng, rules, drifts, kicks, marks, scratch):
     """Advance match ``m`` by one frame with ``actions[m, 0]`` and ``actions[m, 1]``.
 
     ``state`` and ``model`` are the match batch's ``engine.Batch.kernel_arguments()``;
@@ -349,7 +355,7 @@ def step_match(m, actions, state, model, work, ship_gauges, ship_counters, torp_
             torp_life[m, k] -= 1
             if torp_life[m, k] == 0:
                 active[m, 2 + k] = False  # bursts harmlessly
-    _collisions(m, pos, vel, active, ship_counters, torp_life, match_state, rules, doomed)
+    _collisions(m, pos, vel, active, ship_counters, torp_life, match_state, rules, marks)
     _round_logic(m, pos, vel, mass, charge, active, ship_gauges, ship_counters, torp_life,
                  match_state, rules)
 
@@ -364,7 +370,7 @@ def new_scratch(pos):
 @jit()
 def step_all(actions, pos, vel, mass, charge, radius, active, test, pinned, n, box, kinds,
              params, param_offsets, indices, index_offsets, ship_gauges, ship_counters,
-             torp_life, match_state, rng, rules, drifts, kicks, doomed):
+             torp_life, match_state, rng, rules, drifts, kicks, marks):
     """Advance every match by one frame (matches already over are left as they are).
 
     The batch's ``State`` and ``Model`` come in as their arrays (numba reads plain array
@@ -378,7 +384,7 @@ def step_all(actions, pos, vel, mass, charge, radius, active, test, pinned, n, b
     scratch = new_scratch(pos)
     for m in range(pos.shape[0]):
         step_match(m, actions, state, model, work, ship_gauges, ship_counters, torp_life,
-                   match_state, rng, rules, drifts, kicks, doomed, scratch)
+                   match_state, rng, rules, drifts, kicks, marks, scratch)
 
 
 @jit()

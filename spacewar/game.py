@@ -125,7 +125,7 @@ class Game:
         self.match_state = np.zeros((m, core.MI), dtype=np.int64)
         self.rng = np.array([seed_state(s) for s in seeds], dtype=np.uint64)
         self._actions = np.full((m, 2), core.NOOP, dtype=np.int64)
-        self._doomed = np.zeros((m, nb), dtype=np.bool_)  # the collisions' scratch
+        self._doomed = np.zeros((m, 2, nb), dtype=np.int64)  # the collisions' scratch
         core.reset_all(self.pos, self.vel, self.mass, self.charge, self.active, self.ship_gauges,
                        self.ship_counters, self.torp_life, self.match_state, self.rules_vector)
         self._frame_arguments = self._gather_frame_arguments()

@@ -211,7 +211,7 @@ _BOT_MIX = np.uint64(0x2545F4914F6CDD1D)
 @jit(parallel=True)
 def step_learning(actions, pos, vel, mass, charge, radius, active, test, pinned, n, box, kinds,
                   params, param_offsets, indices, index_offsets, ship_gauges, ship_counters,
-                  torp_life, match_state, rng, rules, drifts, kicks, doomed, scales, base,
+                  torp_life, match_state, rng, rules, drifts, kicks, marks, scales, base,
                   episodes, frame_cap, mode, play, pending, observations, final_observations,
                   rewards, terminated, truncated, seats, memory, bot_rng):
     """One call for every match, matches spread over the threads in chunks.
@@ -226,8 +226,9 @@ def step_learning(actions, pos, vel, mass, charge, radius, active, test, pinned,
     +1 when the frame scored a round for seat s and not for the enemy, -1 the other way, else
     0; ``terminated[m]`` at the match's end, ``truncated[m]`` at ``frame_cap`` frames (0:
     none). Under SAME_STEP an ended match writes its last observation into
-    ``final_observations[m]`` and restarts at once. Every match's two seats are then written
-    into ``observations`` (M, 2, D) float32. Nothing is allocated per match."""
+    ``final_observations[m]`` and restarts at once. Every match's seats that the caller
+    plays are then written into ``observations`` (M, 2, D) float32 (a compiled bot's row is
+    not). Nothing is allocated per match."""
     state = State(pos, vel, mass, charge, radius, active, test, pinned, n, box)
     model = Model(kinds, params, param_offsets, indices, index_offsets)
     work = Workspace(np.empty(0), np.empty(0, dtype=np.int64), False)
@@ -246,23 +247,28 @@ def step_learning(actions, pos, vel, mass, charge, radius, active, test, pinned,
                 truncated[m] = False
             elif play:
                 _play_frame(m, actions, state, model, work, ship_gauges, ship_counters,
-                            torp_life, match_state, rng, rules, drifts, kicks, doomed, scratch,
+                            torp_life, match_state, rng, rules, drifts, kicks, marks, scratch,
                             frame_cap, seats, memory, bot_rng, rewards, terminated, truncated)
                 if terminated[m] or truncated[m]:
                     if mode == SAME_STEP:
                         _observe(m, state, ship_gauges, ship_counters, torp_life, match_state,
-                                 rules, scales, final_observations)
+                                 rules, scales, final_observations, seats)
                         _restart(m, state, ship_gauges, ship_counters, torp_life, match_state,
                                  rng, rules, base, episodes, seats, memory, bot_rng)
                     elif mode == NEXT_STEP:
                         pending[m] = True
             _observe(m, state, ship_gauges, ship_counters, torp_life, match_state, rules,
-                     scales, observations)
+                     scales, observations, seats)
 
 
 @jit(inline="always")
-def _observe(m, state, ship_gauges, ship_counters, torp_life, match_state, rules, scales, out):
+def _observe(m, state, ship_gauges, ship_counters, torp_life, match_state, rules, scales, out,
+             seats):
+    """Match m's observations of the seats the caller plays (a compiled bot reads the state
+    itself: its seat's row is left as it was)."""
     for seat in range(2):
+        if seats[seat] >= 0:
+            continue
         write_learning(m, seat, state.pos, state.vel, state.charge, state.active, ship_gauges,
                        ship_counters, torp_life, match_state, rules, scales, out[m, seat])
 
@@ -283,7 +289,7 @@ def _restart(m, state, ship_gauges, ship_counters, torp_life, match_state, rng, 
 
 @jit(inline="always")
 def _play_frame(m, actions, state, model, work, ship_gauges, ship_counters, torp_life,
-                match_state, rng, rules, drifts, kicks, doomed, scratch, frame_cap, seats,
+                match_state, rng, rules, drifts, kicks, marks, scratch, frame_cap, seats,
                 memory, bot_rng, rewards, terminated, truncated):
     """One frame of match m and its rewards and ends (see ``step_learning``)."""
     for s in range(2):
@@ -294,7 +300,7 @@ def _play_frame(m, actions, state, model, work, ship_gauges, ship_counters, torp
     s0 = match_state[m, core.SCORE0]
     s1 = match_state[m, core.SCORE1]
     core.step_match(m, actions, state, model, work, ship_gauges, ship_counters, torp_life,
-                    match_state, rng, rules, drifts, kicks, doomed, scratch)
+                    match_state, rng, rules, drifts, kicks, marks, scratch)
     d0 = match_state[m, core.SCORE0] - s0
     d1 = match_state[m, core.SCORE1] - s1
     r = 0.0
