@@ -67,11 +67,16 @@ def _load(config):
 
     if config.get("path"):
         sys.path.insert(0, config["path"])
+    from .batch_bots import SingleFromBatch, is_batch_bot
+
+    rules = Rules.from_dict(config["rules"])
     bot = make_bot(config["spec"], seed=config["seed"])
+    if is_batch_bot(bot) and not callable(getattr(bot, "act", None)):
+        bot = SingleFromBatch(bot, rules, config["rounds"])  # one match here: K = 1
     reset = getattr(bot, "reset", None)
     if callable(reset):
         reset()
-    return bot, Rules.from_dict(config["rules"])
+    return bot, rules
 
 
 def _answer(bot, rules, frame, raw):

@@ -28,8 +28,8 @@ from numba import prange
 from engine import space
 from engine.state import Model, State, Workspace
 
-from . import compiled_bots_interim as compiled_bots, core
-from .protocol import raw_layout
+from . import compiled_bots, core
+from .protocol import raw_layout, raw_length
 from .rules import Rules
 
 jit = core.jit
@@ -236,6 +236,7 @@ def step_learning(actions, pos, vel, mass, charge, radius, active, test, pinned,
     chunks = min(matches, CHUNKS)
     for c in prange(chunks):
         scratch = core.new_scratch(pos)
+        bot_scratch = compiled_bots.new_scratch(rules)
         for m in range(c * matches // chunks, (c + 1) * matches // chunks):
             if pending[m]:
                 _restart(m, state, ship_gauges, ship_counters, torp_life, match_state, rng,
@@ -248,7 +249,8 @@ def step_learning(actions, pos, vel, mass, charge, radius, active, test, pinned,
             elif play:
                 _play_frame(m, actions, state, model, work, ship_gauges, ship_counters,
                             torp_life, match_state, rng, rules, drifts, kicks, marks, scratch,
-                            frame_cap, seats, memory, bot_rng, rewards, terminated, truncated)
+                            frame_cap, seats, memory, bot_rng, bot_scratch, rewards, terminated,
+                            truncated)
                 if terminated[m] or truncated[m]:
                     if mode == SAME_STEP:
                         _observe(m, state, ship_gauges, ship_counters, torp_life, match_state,
@@ -290,13 +292,13 @@ def _restart(m, state, ship_gauges, ship_counters, torp_life, match_state, rng, 
 @jit(inline="always")
 def _play_frame(m, actions, state, model, work, ship_gauges, ship_counters, torp_life,
                 match_state, rng, rules, drifts, kicks, marks, scratch, frame_cap, seats,
-                memory, bot_rng, rewards, terminated, truncated):
+                memory, bot_rng, bot_scratch, rewards, terminated, truncated):
     """One frame of match m and its rewards and ends (see ``step_learning``)."""
     for s in range(2):
         if seats[s] >= 0:
-            actions[m, s] = compiled_bots.decide(
+            actions[m, s] = compiled_bots.decide_with(
                 seats[s], m, s, state.pos, state.vel, state.charge, state.active, ship_gauges,
-                ship_counters, torp_life, match_state, rules, memory, bot_rng)
+                ship_counters, torp_life, match_state, rules, memory, bot_rng, bot_scratch)
     s0 = match_state[m, core.SCORE0]
     s1 = match_state[m, core.SCORE1]
     core.step_match(m, actions, state, model, work, ship_gauges, ship_counters, torp_life,
@@ -463,7 +465,58 @@ def learning_vector(raw, rules, rounds):
     return np.array(out, dtype=np.float32)
 
 
+def learning_vectors(raws, rules, rounds):
+    """``learning_vector`` of each row of ``raws`` ((K, raw length) raw observations) at once,
+    vectorised in NumPy: (K, D) float32, the same numbers (a batch bot's process computes
+    these from the raw observations it is sent)."""
+    raws = np.asarray(raws, dtype=np.float64)
+    n = raw_length(rules)
+    if raws.ndim != 2 or raws.shape[1] != n:
+        raise ValueError(f"raws must have shape (K, {n}), got {raws.shape}")
+    index = {name: k for k, name in enumerate(raw_layout(rules))}
+    s = learning_scales(rules, rounds)
+    sp, sv = s[2], s[3]
+
+    def col(name):
+        return raws[:, index[name]]
+
+    def rel(d):
+        return space.nearest_image(d, 1.0) * sp
+
+    x0, y0, vx0, vy0 = col("me.x"), col("me.y"), col("me.vx"), col("me.vy")
+    out = np.empty((raws.shape[0], learning_length(rules)))
+    head = [col("round_frame") * s[0], col("round") * s[1],
+            (col("score_me") - col("score_enemy")) * s[1],
+            (col("star_mu") > 0.0).astype(np.float64), col("star_mu") * s[12],
+            np.full(raws.shape[0], s[13])]
+    own = [vx0 * sv, vy0 * sv, np.cos(col("me.heading")), np.sin(col("me.heading")),
+           col("me.angular_velocity") * s[4], col("me.fuel") * s[5], col("me.torpedoes") * s[6],
+           col("me.hyperspace") * s[7], col("me.alive"), col("me.in_hyperspace"),
+           col("me.reload") * s[8], col("me.hyperspace_recharge") * s[9],
+           np.sign(col("me.charge")), col("me.flip_cooldown") * s[10]]
+    star = [rel(0.0 - x0), rel(0.0 - y0)]
+    enemy = [rel(col("enemy.x") - x0), rel(col("enemy.y") - y0), (col("enemy.vx") - vx0) * sv,
+             (col("enemy.vy") - vy0) * sv, np.cos(col("enemy.heading")),
+             np.sin(col("enemy.heading")), col("enemy.angular_velocity") * s[4],
+             col("enemy.fuel") * s[5], col("enemy.torpedoes") * s[6],
+             col("enemy.hyperspace") * s[7], col("enemy.alive"), col("enemy.in_hyperspace"),
+             np.sign(col("enemy.charge"))]
+    for k, column in enumerate(head + own + star + enemy):
+        out[:, k] = column
+    k = _TORPEDOES
+    for t in range(2 * rules.torpedoes):
+        present = col(f"torpedo{t}.present") != 0.0
+        rows = [np.ones(raws.shape[0]), rel(col(f"torpedo{t}.x") - x0),
+                rel(col(f"torpedo{t}.y") - y0), (col(f"torpedo{t}.vx") - vx0) * sv,
+                (col(f"torpedo{t}.vy") - vy0) * sv, col(f"torpedo{t}.ttl") * s[11]]
+        for j, column in enumerate(rows):
+            out[:, k + j] = np.where(present, column, 0.0)
+        k += _NT
+    return out.astype(np.float32)
+
+
 __all__ = ["learning_layout", "learning_length", "learning_scales", "learning_vector",
+           "learning_vectors",
            "write_learning", "write_all_learning", "episode_stream", "step_learning",
            "LearningBatch", "seat_kinds", "AUTORESET_MODES", "NEXT_STEP", "SAME_STEP", "DISABLED",
            "EXTERNAL"]

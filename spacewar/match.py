@@ -85,7 +85,8 @@ def play_match(p1, p2, seed=0, rounds=5, rules=None, budget=DEFAULT_BUDGET,
     start = time.perf_counter()
     try:
         for s, spec in enumerate((p1, p2)):
-            seats.append(open_seat(spec, bot_seed(seed, s), limits, rules, isolation, cpu))
+            seats.append(open_seat(spec, bot_seed(seed, s), limits, rules, isolation, cpu,
+                                   rounds=rounds))
         for s, seat in enumerate(seats):
             if hasattr(seat, "wait_ready") and seat.wait_ready() is not None:
                 faults[s].add(0, *seat.dead)
@@ -135,12 +136,13 @@ def _cpu_seconds(rules, rounds, limits):
     return int(math.ceil(limits.startup + limits.overage + frames * limits.budget)) + 5
 
 
-def _result(game, bots, seed, rounds, rules, faults, forfeits, outputs):
-    score = [int(x) for x in game.scores[0]]
+def _result(game, bots, seed, rounds, rules, faults, forfeits, outputs, m=0):
+    """Match ``m``'s plain-data result (see the module's text)."""
+    score = [int(x) for x in game.scores[m]]
     forfeit = forfeits.index(True) if forfeits.count(True) == 1 else None
     if any(forfeits):
         winner = None if forfeit is None else 1 - forfeit
-    elif game.errored(0):
+    elif game.errored(m):
         winner = None
     elif score[0] != score[1]:
         winner = 0 if score[0] > score[1] else 1
@@ -151,11 +153,11 @@ def _result(game, bots, seed, rounds, rules, faults, forfeits, outputs):
         "winner": None if winner is None else bots[winner],
         "winner_seat": winner,
         "score": score,
-        "rounds": game.rounds_played(0),
-        "steps": int(game.frame[0]),
+        "rounds": game.rounds_played(m),
+        "steps": int(game.frame[m]),
         "forfeit": None if forfeit is None else bots[forfeit],
         "forfeits": [bool(f) for f in forfeits],
-        "error": game.errored(0),
+        "error": game.errored(m),
         "faults": [faults[0].to_dict(), faults[1].to_dict()],
         "seed": int(seed),
         "rounds_asked": int(rounds),

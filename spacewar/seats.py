@@ -35,6 +35,7 @@ import tempfile
 import time
 
 from . import codes, confinement, wire
+from .batch_bots import SingleFromBatch, is_batch_bot
 from .bots import absolute_spec, is_builtin, locate, make_bot
 from .protocol import observation_from_raw
 
@@ -44,6 +45,8 @@ SHOWN_OUTPUT = 4096  # bytes of a bot's stdout and stderr kept in the result
 
 
 MAX_SECONDS = 3600.0  # no budget of a bot's is longer than an hour
+#: rounds a batch bot's learning observations are scaled by when the caller does not say
+DEFAULT_ROUNDS = 3
 MAX_CPU_SECONDS = 1 << 30
 
 
@@ -119,7 +122,7 @@ class InlineSeat:
     here (trusted code, fast). Its faults, ``SystemExit`` and ``KeyboardInterrupt`` included,
     cost it its turn; it sees a read-only observation and its own copy of the rules."""
 
-    def __init__(self, spec, seed, limits, rules, bot=None):
+    def __init__(self, spec, seed, limits, rules, bot=None, rounds=None):
         if bot is None and not is_builtin(spec):
             raise ValueError(f"inline seats are for built-in bots only, got {spec!r}: "
                              "other bots run in their own process")
@@ -130,6 +133,9 @@ class InlineSeat:
         self.dead = None
         self.layers = ["in this process (built-in bot or the caller's bot object)"]
         self.bot = make_bot(spec, seed=seed) if bot is None else bot
+        if is_batch_bot(self.bot) and not callable(getattr(self.bot, "act", None)):
+            self.bot = SingleFromBatch(self.bot, self._rules, DEFAULT_ROUNDS if rounds is None
+                                       else rounds)
         try:
             reset = getattr(self.bot, "reset", None)
             if callable(reset):
@@ -189,7 +195,7 @@ def _bot_environment(scratch):
 class ProcessSeat:
     """A bot in its own confined process. Construction starts it; ``wait_ready`` waits."""
 
-    def __init__(self, spec, seed, limits, rules, cpu_seconds=None):
+    def __init__(self, spec, seed, limits, rules, cpu_seconds=None, rounds=None):
         self.spec = spec
         self.limits = limits
         self.bank = _Bank(limits)
@@ -204,6 +210,7 @@ class ProcessSeat:
         self._to_bot = self._from_bot = self._log_fd = -1
         self._dir = None
         self._started = time.monotonic()
+        self._rounds = DEFAULT_ROUNDS if rounds is None else int(rounds)
         _, self._user, self._namespaces = confinement.launch_plan()
         read_dirs, list_dirs, search_path = locate(spec)  # a bad spec raises here, first
         try:
@@ -228,6 +235,7 @@ class ProcessSeat:
         dirs, files = confinement.read_paths(extra_dirs=read_dirs)
         config = {
             "spec": absolute_spec(spec), "seed": int(seed), "rules": rules.to_dict(),
+            "rounds": self._rounds,
             "path": search_path, "output_bytes": limits.output_bytes,
             "confinement": {"numba_cache": _compiled_code_dirs(), "scratch": scratch,
                             "scratch_mb": limits.scratch_mb, "memory_mb": limits.memory_mb,
@@ -593,11 +601,14 @@ def bot_name(spec):
     return f"{cls.__module__}.{cls.__qualname__}"
 
 
-def open_seat(spec, seed, limits=None, rules=None, isolation="auto", cpu_seconds=None):
+def open_seat(spec, seed, limits=None, rules=None, isolation="auto", cpu_seconds=None,
+              rounds=None):
     """A seat for bot ``spec``: built-in bots inline (``auto``), every other bot named by a
     string in its own confined process. ``isolation="process"`` puts built-in bots in a process
     too; ``inline`` is refused for a named bot that is not built in. A bot *object* (anything
-    with ``act``) is the caller's own code and plays inline."""
+    with ``act``, or a batch bot with ``act_batch``: ``spacewar.batch_bots``) is the caller's
+    own code and plays inline. ``rounds``: the match's, which a batch bot's learning
+    observations are scaled by."""
     from .rules import Rules
 
     if isolation not in ("auto", "inline", "process"):
@@ -606,12 +617,12 @@ def open_seat(spec, seed, limits=None, rules=None, isolation="auto", cpu_seconds
     if isinstance(limits, (int, float)):
         limits = Limits(budget=limits)  # the old call shape: a budget in seconds
     rules = Rules() if rules is None else rules
-    if not isinstance(spec, str) and callable(getattr(spec, "act", None)):
-        return InlineSeat(bot_name(spec), seed, limits, rules, bot=spec)
+    if not isinstance(spec, str) and (callable(getattr(spec, "act", None)) or is_batch_bot(spec)):
+        return InlineSeat(bot_name(spec), seed, limits, rules, bot=spec, rounds=rounds)
     if not is_builtin(spec):
         locate(spec)  # a bad specification is an error here, before any process starts
     if is_builtin(spec) and isolation != "process":
-        return InlineSeat(spec, seed, limits, rules)
+        return InlineSeat(spec, seed, limits, rules, rounds=rounds)
     if isolation == "inline":
         raise ValueError(f"inline isolation is for built-in bots only, got {spec!r}")
-    return ProcessSeat(spec, seed, limits, rules, cpu_seconds=cpu_seconds)
+    return ProcessSeat(spec, seed, limits, rules, cpu_seconds=cpu_seconds, rounds=rounds)

@@ -40,11 +40,37 @@ def schedule(bots, games, seed):
 
 
 def _play(job):
-    p1, p2, match_seed, rounds, rules_dict, limits, max_faults, isolation = job
-    result, _, timing = play_match(p1, p2, seed=match_seed, rounds=rounds,
-                                   rules=Rules.from_dict(rules_dict), limits=limits,
-                                   max_faults=max_faults, isolation=isolation)
-    return result, timing
+    """A job's outcomes ``[(result, timing), ...]``: one match, or every match of a pairing
+    with a batch bot, played together (``spacewar.batch_match``)."""
+    matches, rounds, rules_dict, limits, max_faults, isolation = job
+    rules = Rules.from_dict(rules_dict)
+    if len(matches) > 1:
+        from .batch_match import play_matches
+
+        return play_matches(matches, rounds=rounds, rules=rules, limits=limits,
+                            max_faults=max_faults)
+    (p1, p2, match_seed), = matches
+    result, _, timing = play_match(p1, p2, seed=match_seed, rounds=rounds, rules=rules,
+                                   limits=limits, max_faults=max_faults, isolation=isolation)
+    return [(result, timing)]
+
+
+def _jobs(schedule_, isolation):
+    """The schedule cut into jobs: each match alone, except that a pairing with a batch bot
+    (a policy file) and a bot that can share its game (``batch_match.can_play_together``)
+    is one job, all its matches in one game, the batch bot answering for all of them at
+    once. Built-in bots forced into processes (``isolation="process"``) play alone."""
+    from .batch_match import can_play_together, is_batch_spec
+
+    jobs = []
+    for p1, p2, seed in schedule_:
+        together = (isolation != "process" and (is_batch_spec(p1) or is_batch_spec(p2))
+                    and can_play_together(p1) and can_play_together(p2))
+        if together and jobs and jobs[-1][0] and {p1, p2} == jobs[-1][2]:
+            jobs[-1][1].append((p1, p2, seed))
+        else:
+            jobs.append((together, [(p1, p2, seed)], {p1, p2}))
+    return [matches for _, matches, _ in jobs]
 
 
 def _worker_start():
@@ -109,25 +135,26 @@ def run_tournament(bots, games=10, seed=1, rounds=3, rules=None, workers=None, p
     if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
         raise ValueError(f"workers must be an int >= 1, got {workers!r}")
     limits = Limits(budget=budget) if limits is None else limits
-    jobs = [(p1, p2, s, rounds, rules.to_dict(), limits, max_faults, isolation)
-            for p1, p2, s in schedule(bots, games, seed)]
+    jobs = [(matches, rounds, rules.to_dict(), limits, max_faults, isolation)
+            for matches in _jobs(schedule(bots, games, seed), isolation)]
+    total = sum(len(job[0]) for job in jobs)
     if workers > 1:
         _warm_up(rules)
-    bar = _progress(len(jobs), progress)
+    bar = _progress(total, progress)
     outcomes = []
     if workers == 1:
         for job in jobs:
-            outcomes.append(_play(job))
-            bar.update(1)
+            outcomes.extend(_play(job))
+            bar.update(len(job[0]))
     else:
         ctx = multiprocessing.get_context("spawn")
         with concurrent.futures.ProcessPoolExecutor(max_workers=workers, mp_context=ctx,
                                                     initializer=_worker_start) as pool:
-            futures = [pool.submit(_play, job) for job in jobs]
+            futures = {pool.submit(_play, job): len(job[0]) for job in jobs}
             for future in concurrent.futures.as_completed(futures):
                 future.result()  # surface worker errors early
-                bar.update(1)
-            outcomes = [f.result() for f in futures]
+                bar.update(futures[future])
+            outcomes = [outcome for f in futures for outcome in f.result()]
     bar.close()
     matches = [r for r, _ in outcomes]
     frames = sum(r["steps"] for r in matches)

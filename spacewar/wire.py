@@ -94,8 +94,11 @@ def ask(bot, obs):
     match for a bot it calls directly (``spacewar.seats.InlineSeat``). The code comes from the
     answer's fields (``spacewar.protocol.action_code``), never from what its class says.
     """
+    from .batch_bots import SingleFromBatch
     from .protocol import _short_repr, action_code
 
+    if isinstance(bot, SingleFromBatch):  # a batch bot playing one match: K = 1
+        return bot.answer(obs)
     try:
         result = bot.act(obs)
     except MemoryError:

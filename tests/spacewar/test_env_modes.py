@@ -169,3 +169,37 @@ def test_human_rendering_opens_the_window(monkeypatch):
     assert env._screen is not None and env._screen.get_size() == (240, 240)
     env.close()
     assert env._screen is None
+
+
+@pytest.mark.parametrize("name", ["chaser", "sniper"])
+def test_a_compiled_opponent_decides_as_its_python_twin_inside_the_env(name):
+    from spacewar.bots import make_bot
+    from spacewar.protocol import action_code
+
+    vec = envs.SpacewarVectorEnv(3, opponent=name, max_frames=2000)
+    vec.reset(seed=9)
+    twins = [make_bot(name) for _ in range(3)]
+    rng = np.random.default_rng(2)
+    agree = total = 0
+    for frame in range(150):
+        game = vec.batch.game
+        expected = [action_code(twins[m].act(game.observe(m, 1))) for m in range(3)]
+        vec.step(rng.integers(0, [3, 2, 2, 2], size=(3, 4)))
+        if frame > 0:  # the first call starts the episodes
+            agree += int((vec.batch.actions[:, 1] == expected).sum())
+            total += 3
+    assert agree == total
+
+
+def test_a_compiled_opponent_plays_the_same_whatever_the_batch_size():
+    small = envs.SpacewarVectorEnv(2, opponent="chaser", max_frames=300)
+    large = envs.SpacewarVectorEnv(5, opponent="chaser", max_frames=300)
+    a, _ = small.reset(seed=4)
+    b, _ = large.reset(seed=4)
+    rng = np.random.default_rng(3)
+    for _ in range(320):
+        parts = rng.integers(0, [3, 2, 2, 2], size=(5, 4))
+        a = small.step(parts[:2])[0]
+        b = large.step(parts)[0]
+        np.testing.assert_array_equal(a, b[:2])
+        np.testing.assert_array_equal(small.batch.actions, large.batch.actions[:2])

@@ -1,0 +1,114 @@
+"""Batch bots: one call decides for every match a bot plays at once.
+
+A batch bot is any object with ``act_batch(self, obs) -> codes``:
+
+- ``obs`` is a (K, D) float32 array, one learning observation per match
+  (``spacewar.learning.learning_layout(rules)`` names the D entries: egocentric, scaled to
+  about [-1, 1]; the same numbers ``spacewar.envs`` gives learning code);
+- ``codes`` is K game action codes, integers in [0, ``spacewar.codes.N_ACTIONS``) (``turn + 1
+  + 3 thrust + 6 fire + 12 hyperspace + 24 flip``; ``spacewar.envs.codes_from_parts`` turns
+  MultiDiscrete parts into codes), as a sequence or array of K ints.
+
+It may define ``reset(self)``, called before the first frame. When its matches are played
+together (``spacewar.batch_match.play_matches``), the rows are its matches in a fixed order,
+every frame until the last one ends: the row of a finished match keeps its last observation
+and its action is ignored. Played one match at a time (``spacewar match``, a confined bot
+from a file), it is called with K = 1.
+
+A NumPy or PyTorch policy so plays hundreds of matches in one forward pass.
+"""
+import numpy as np
+
+from . import codes
+from .wire import INVALID, MEMORY, OK, RAISED, exception_text
+
+
+def is_batch_bot(bot):
+    """Whether ``bot`` answers for many matches at once (it has a callable ``act_batch``)."""
+    try:
+        return callable(getattr(bot, "act_batch", None))
+    except BaseException:  # a hostile __getattr__ is not a batch bot
+        return False
+
+
+def ask_batch(bot, obs):
+    """``(status, codes, text)`` for ``bot.act_batch(obs)``, whatever it does: ``codes`` is a
+    (K,) int64 array of valid action codes when ``status`` is OK, else K no-ops, and ``text``
+    says what went wrong (the statuses of ``spacewar.wire``)."""
+    k = obs.shape[0]
+    noop = np.full(k, codes.NOOP, dtype=np.int64)
+    try:
+        answer = bot.act_batch(obs)
+    except MemoryError:
+        return MEMORY, noop, "MemoryError in act_batch"
+    except BaseException as exc:  # SystemExit and KeyboardInterrupt from a bot are its faults
+        return RAISED, noop, exception_text(exc)
+    try:
+        return OK, checked_codes(answer, k), ""
+    except ValueError as exc:
+        return INVALID, noop, str(exc)
+    except BaseException as exc:
+        return INVALID, noop, exception_text(exc)
+
+
+def checked_codes(answer, k):
+    """``answer`` as (k,) int64 action codes, or ValueError saying why it is not."""
+    if isinstance(answer, np.ndarray):
+        array = answer
+    elif isinstance(answer, (list, tuple)):
+        if len(answer) != k or not all(type(x) in _INT_TYPES for x in answer):
+            raise ValueError(f"act_batch must return {k} integer action codes")
+        array = np.array([int(x) for x in answer], dtype=np.int64)
+    else:
+        raise ValueError(f"act_batch must return a sequence or array of {k} action codes, got "
+                         f"{type(answer).__name__}")
+    if array.shape != (k,) or array.dtype.kind not in "iu":
+        raise ValueError(f"act_batch must return {k} integer action codes, got "
+                         f"{array.dtype} {array.shape}")
+    array = array.astype(np.int64)
+    bad = (array < 0) | (array >= codes.N_ACTIONS)
+    if bad.any():
+        raise ValueError(f"action code {int(array[bad][0])} out of range [0, {codes.N_ACTIONS})")
+    return array
+
+
+_INT_TYPES = (int, np.int8, np.int16, np.int32, np.int64, np.uint8, np.uint16, np.uint32,
+              np.uint64)
+
+
+class SingleFromBatch:
+    """A batch bot playing one match: ``act(obs)`` asks ``act_batch`` with K = 1 on the
+    learning observation of the ``Observation`` it gets (``spacewar.learning.learning_vector``
+    of its raw numbers). ``rounds`` is the match's (the learning observation scales the
+    score and round count by it)."""
+
+    def __init__(self, bot, rules, rounds):
+        self.bot = bot
+        self.rules = rules
+        self.rounds = int(rounds)
+
+    def reset(self):
+        reset = getattr(self.bot, "reset", None)
+        if callable(reset):
+            reset()
+
+    def answer(self, obs):
+        """``(status, code, text)`` as ``spacewar.wire.ask`` gives for a bot with ``act``."""
+        from .learning import learning_vector
+
+        raw = object.__getattribute__(obs, "_raw")
+        status, answer, text = ask_batch(self.bot, learning_vector(raw, self.rules,
+                                                                   self.rounds)[None])
+        return status, int(answer[0]), text
+
+    def act(self, obs):
+        """The ``Action`` (for a caller that wants one; raises what act_batch raised)."""
+        from .protocol import Action
+
+        status, code, text = self.answer(obs)
+        if status != OK:
+            raise ValueError(f"act_batch failed: {text}")
+        return Action.from_code(code)
+
+
+__all__ = ["is_batch_bot", "ask_batch", "checked_codes", "SingleFromBatch"]
