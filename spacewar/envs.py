@@ -42,6 +42,9 @@ Opponents
 Seeding
     ``reset(seed=s)``: match m's episode e plays a stream made from (s, m, e) alone, so runs
     are reproducible whatever the number of envs or threads.
+Copies
+    The vector env returns fresh arrays (``copy=True``); ``copy=False`` returns views of the
+    batch's own buffers, overwritten by the next step, as Gymnasium's ``SyncVectorEnv``.
 Rendering
     ``SpacewarEnv(render_mode="rgb_array")``: ``render()`` gives a (480, 480, 3) uint8 frame
     drawn by ``spacewar.render``; ``"human"``: the pygame window (``[viz]`` extra).
@@ -178,7 +181,8 @@ class SpacewarVectorEnv(VectorEnv):
     metadata = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": []}
 
     def __init__(self, num_envs=1, opponent="random", rules=None, rounds=3, max_frames=20000,
-                 render_mode=None, autoreset_mode="next_step", action_type="multi_discrete"):
+                 render_mode=None, autoreset_mode="next_step", action_type="multi_discrete",
+                 copy=True):
         if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)) \
                 or num_envs < 1:
             raise ValueError(f"num_envs must be an int >= 1, got {num_envs!r}")
@@ -207,6 +211,9 @@ class SpacewarVectorEnv(VectorEnv):
         self.action_space = batch_space(self.single_action_space, self.num_envs)
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
         self._batch = None
+        # as Gymnasium's SyncVectorEnv(copy=...): False returns views of the batch's own
+        # buffers, which the next step overwrites (no copy of 4096 x 419 floats per step)
+        self.copy = bool(copy)
 
     def _new_batch(self, seed):
         seed = int(np.random.SeedSequence(seed).entropy if seed is None else seed)
@@ -238,7 +245,10 @@ class SpacewarVectorEnv(VectorEnv):
                 self._new_batch(seed)
             self._batch.reset()
         self._opponent.episode_started()
-        return self._view(self._batch.observations).copy(), {}
+        return self._out(self._view(self._batch.observations)), {}
+
+    def _out(self, array):
+        return array.copy() if self.copy else array
 
     def _match_mask(self, mask):
         mask = np.asarray(mask)
@@ -278,7 +288,7 @@ class SpacewarVectorEnv(VectorEnv):
             infos = self._final_infos(batch)
         if self._opponent.bot is not None and batch.episodes[0] != episodes[0]:
             self._opponent.episode_started()
-        return (self._view(obs).copy(), self._view(rewards).astype(np.float64),
+        return (self._out(self._view(obs)), self._view(rewards).astype(np.float64),
                 self._per_agent(terminated), self._per_agent(truncated), infos)
 
     def _final_infos(self, batch):

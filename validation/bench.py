@@ -461,13 +461,13 @@ def bench_batch(systems=4096, slots=66, repeats=5):
 
 
 # -- 8. Spacewar for learning code: spacewar.learning and spacewar.envs -----------------------
-def _vector_env_rate(opponent, matches, frames, repeats, seed=1):
+def _vector_env_rate(opponent, matches, frames, repeats, seed=1, copy=True):
     """Match-frames per second of ``SpacewarVectorEnv.step`` with random actions (the env's
     own checks, the conversion of actions, observations, rewards and flags included) and
     the final observations, so that runs at different thread counts can be compared."""
     from spacewar.envs import SpacewarVectorEnv
 
-    env = SpacewarVectorEnv(matches, opponent=opponent, max_frames=3000)
+    env = SpacewarVectorEnv(matches, opponent=opponent, max_frames=3000, copy=copy)
     env.reset(seed=seed)
     actions = np.random.default_rng(0).integers(0, [3, 2, 2, 2], size=(frames, matches, 4))
     env.step(actions[0])
@@ -504,7 +504,10 @@ def bench_learning(matches=4096, frames=50, repeats=3, opponents=("random", "cha
         for opponent in opponents:
             rate, obs = _vector_env_rate(opponent, matches, frames, repeats)
             row[f"vector_env_vs_{opponent}_match_frames_per_second"] = rate
-            final.append(obs)
+            final.append(obs.copy())
+        rate, obs = _vector_env_rate("random", matches, frames, repeats, copy=False)
+        row["vector_env_vs_random_no_copy_match_frames_per_second"] = rate
+        final.append(obs.copy())
         rows[str(count)] = row
         finals.append(final)
     same = all(np.array_equal(a, b) for other in finals[1:] for a, b in zip(finals[0], other))
@@ -760,7 +763,9 @@ def format_report(r):
                          f"{row['match_frames_per_second']:.3e}" + "".join(
                              f"; SpacewarVectorEnv.step vs {o} "
                              f"{row[f'vector_env_vs_{o}_match_frames_per_second']:.3e}"
-                             for o in g["opponents"]))
+                             for o in g["opponents"])
+                         + f"; vs random with copy=False "
+                           f"{row['vector_env_vs_random_no_copy_match_frames_per_second']:.3e}")
         h = g["harness"]
         lines.append(f"  one match of two idle Python bots: {h['seconds_per_frame'] * 1e6:.1f} us "
                      f"per frame, of which the bots' act {2 * h['act_seconds'] * 1e6:.2f} us: the "
@@ -877,11 +882,14 @@ def format_markdown(r, command):
                 + ("identical" if g["identical_across_threads"] else "**different**")
                 + " at every thread count. Match-frames per second:", "",
                 "| threads | `LearningBatch.step` | "
-                + " | ".join(f"`SpacewarVectorEnv.step` vs {o}" for o in opponents) + " |",
-                "|---|---|" + "---|" * len(opponents)]
+                + " | ".join(f"`SpacewarVectorEnv.step` vs {o}" for o in opponents)
+                + " | vs random, `copy=False` |",
+                "|---|---|" + "---|" * (len(opponents) + 1)]
         out += [f"| {count} | {row['match_frames_per_second']:.3e} | " + " | ".join(
                     f"{row[f'vector_env_vs_{o}_match_frames_per_second']:.3e}"
-                    for o in opponents) + " |" for count, row in g["threads"].items()]
+                    for o in opponents)
+                + f" | {row['vector_env_vs_random_no_copy_match_frames_per_second']:.3e} |"
+                for count, row in g["threads"].items()]
         h = g.get("harness")
         if h:
             out += ["", f"One match of two idle Python bots ({h['frames']} frames): "

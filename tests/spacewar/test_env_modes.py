@@ -203,3 +203,17 @@ def test_a_compiled_opponent_plays_the_same_whatever_the_batch_size():
         b = large.step(parts)[0]
         np.testing.assert_array_equal(a, b[:2])
         np.testing.assert_array_equal(small.batch.actions, large.batch.actions[:2])
+
+
+def test_copy_false_returns_the_batchs_own_buffers_with_the_same_numbers():
+    copied = envs.SpacewarVectorEnv(3, opponent="random", max_frames=100)
+    shared = envs.SpacewarVectorEnv(3, opponent="random", max_frames=100, copy=False)
+    a, _ = copied.reset(seed=1)
+    b, _ = shared.reset(seed=1)
+    assert not np.shares_memory(a, copied.batch.observations)
+    assert np.shares_memory(b, shared.batch.observations)
+    parts = np.random.default_rng(0).integers(0, [3, 2, 2, 2], size=(120, 3, 4))
+    for p in parts:
+        a = copied.step(p)[0]
+        b = shared.step(p)[0]
+        np.testing.assert_array_equal(a, b)
