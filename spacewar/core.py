@@ -45,13 +45,16 @@ from .codes import N_ACTIONS, NOOP  # noqa: E402  (kept here: core.NOOP is used 
 
 #: numba's njit with this module's compiled code in the game's cache directory
 jit = compiler("spacewar")
+# The frame's helpers are compiled without numba's reference counting (``_nrt=False``: they
+# allocate nothing), as the engine's force kernels are: with it, each call pays two atomic
+# updates per array argument, which for a dozen arrays was most of a match-frame's fixed cost.
 
 _GOLDEN = np.uint64(0x9E3779B97F4A7C15)
 _MIX1 = np.uint64(0xBF58476D1CE4E5B9)
 _MIX2 = np.uint64(0x94D049BB133111EB)
 
 
-@jit()
+@jit(_nrt=False)
 def next_u64(rng, m):
     """splitmix64 (Steele, Lea & Flood 2014): the next 64 random bits of match m's stream."""
     z = rng[m] + _GOLDEN
@@ -61,7 +64,7 @@ def next_u64(rng, m):
     return z ^ (z >> np.uint64(31))
 
 
-@jit()
+@jit(_nrt=False)
 def uniform(rng, m):
     """A float in [0, 1) with 53 random bits."""
     return float(next_u64(rng, m) >> np.uint64(11)) * (1.0 / 9007199254740992.0)
@@ -82,7 +85,7 @@ def ship_start(s, rules):
     return d, -d, 0.5 * math.pi
 
 
-@jit()
+@jit(_nrt=False)
 def reset_round(m, pos, vel, mass, charge, active, ship_gauges, ship_counters, torp_life, match_state, rules):
     """Ships back to their start, full stores, torpedoes cleared."""
     ntorp = int(rules[R_NTORP])
@@ -119,7 +122,7 @@ def reset_round(m, pos, vel, mass, charge, active, ship_gauges, ship_counters, t
     match_state[m, END_TIMER] = -1
 
 
-@jit()
+@jit(_nrt=False)
 def _kill_ship(m, s, active, ship_counters, frame):
     if ship_counters[m, s, ALIVE] == 1:
         ship_counters[m, s, ALIVE] = 0
@@ -128,7 +131,7 @@ def _kill_ship(m, s, active, ship_counters, frame):
         active[m, s] = False
 
 
-@jit()
+@jit(_nrt=False)
 def _fire(m, s, pos, vel, mass, charge, active, ship_gauges, ship_counters, torp_life, rules):
     ntorp = int(rules[R_NTORP])
     k = ntorp - ship_counters[m, s, TORPS]  # each torpedo of a round has its own slot
@@ -148,7 +151,7 @@ def _fire(m, s, pos, vel, mass, charge, active, ship_gauges, ship_counters, torp
     ship_counters[m, s, RELOAD] = int(rules[R_RELOAD])
 
 
-@jit()
+@jit(_nrt=False)
 def _reenter(m, s, pos, vel, active, ship_gauges, ship_counters, rng, rules):
     """Back from hyperspace at a random place, speed and heading; jump k breaks up with k/8."""
     ship_counters[m, s, IN_HYPER] = 0
@@ -171,7 +174,7 @@ def _reenter(m, s, pos, vel, active, ship_gauges, ship_counters, rng, rules):
     return uniform(rng, m) < breakup
 
 
-@jit()
+@jit(_nrt=False)
 def _control(m, s, code, frame, pos, vel, mass, charge, active, ship_gauges, ship_counters, torp_life, force_params,
              rng, rules):
     """Apply one ship's action for this frame: turn, thrust, fire, hyperspace, polarity."""
@@ -238,7 +241,7 @@ def _control(m, s, code, frame, pos, vel, mass, charge, active, ship_gauges, shi
     ship_counters[m, s, FIRE_LATCH] = 1 if fire else 0
 
 
-@jit()
+@jit(_nrt=False)
 def _hit(pos, m, a, b, box, diamond):
     """The original's diamond proximity test, by the nearest image on the torus."""
     dx = abs(space.wrap_scalar(pos[m, 0, b] - pos[m, 0, a], 1.0))  # the nearest image
@@ -246,7 +249,7 @@ def _hit(pos, m, a, b, box, diamond):
     return dx < box and dy < box and dx + dy < diamond
 
 
-@jit()
+@jit(_nrt=False)
 def _collisions(m, pos, vel, active, ship_counters, torp_life, match_state, rules, marks):
     """Torpedoes and ships that touch, and what the star captures. ``marks`` (M, 2, bodies)
     int64 is scratch, so a frame allocates nothing: row 0 lists the live bodies (the pair
@@ -292,7 +295,7 @@ def _collisions(m, pos, vel, active, ship_counters, torp_life, match_state, rule
                 torp_life[m, b - 2] = 0
 
 
-@jit()
+@jit(_nrt=False)
 def _round_logic(m, pos, vel, mass, charge, active, ship_gauges, ship_counters, torp_life, match_state, rules):
     """End of round (a ship lost, both out of torpedoes, or the time limit), then scoring."""
     match_state[m, ROUND_FRAME] += 1

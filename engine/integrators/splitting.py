@@ -82,7 +82,7 @@ def advance(t, h, steps, state, model, work, vdep, t_end, drifts, kicks):
     return _advance_general(t, h, steps, state, model, work, vdep, drifts, kicks, scratch)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def advance_in(t, h, steps, state, model, work, vdep, t_end, drifts, kicks, scratch):
     """``advance`` in caller-owned ``scratch`` of at least ``scratch_rows(dim)`` rows and
     ``n`` columns, so that a compiled caller stepping many small systems (the game's
@@ -91,6 +91,14 @@ def advance_in(t, h, steps, state, model, work, vdep, t_end, drifts, kicks, scra
         f0 = model.param_offsets[0]
         return fused_gravity.advance(t, h, steps, state.pos, state.vel, state.mass, state.active,
                                      state.n, model.params[f0], model.params[f0 + 1], drifts, kicks)
+    return _advance_general_in(t, h, steps, state, model, work, vdep, drifts, kicks, scratch)
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _advance_general_in(t, h, steps, state, model, work, vdep, drifts, kicks, scratch):
+    """The general executor as a call compiled without reference counting (``_nrt=False``,
+    as the force kernels are: it allocates nothing), so that a caller stepping system after
+    system does not pay two atomic updates per array of the state and model on each call."""
     return _advance_general(t, h, steps, state, model, work, vdep, drifts, kicks, scratch)
 
 
