@@ -1,4 +1,4 @@
-"""The ``spacewar`` command: bots, match, tournament, replay, play."""
+"""The ``spacewar`` command: bots, match, tournament, replay, play, train."""
 import argparse
 import json
 import math
@@ -142,6 +142,21 @@ def build_parser():
     p.add_argument("--rounds", type=_positive_int, default=5)
     p.add_argument("--fps", type=_positive_int, default=60)
     _add_rules_options(p)
+
+    tr = sub.add_parser("train", **fmt, help="train a policy with PPO and save it as .npz "
+                                             "(needs the [rl] extra: JAX and optax)")
+    tr.add_argument("--opponent", default="random",
+                    help="the opponent it trains against: a compiled bot of the vector env "
+                         "(spacewar.envs.OPPONENTS) or a policy .npz")
+    tr.add_argument("--minutes", type=_positive_float, default=10.0, help="wall-clock budget")
+    tr.add_argument("--out", default="policy.npz", help="the policy file to write (checked first)")
+    tr.add_argument("--seed", type=_seed, default=0,
+                    help="seeds the network, the sampled actions and the matches")
+    tr.add_argument("--envs", type=_positive_int, default=512, help="matches played side by side")
+    tr.add_argument("--steps", type=lambda text: _int(text, 1, 2**62), default=None,
+                    help="stop after this many frames over all matches (reproducible); "
+                         "None: when the minutes are up")
+    tr.add_argument("--no-progress", action="store_true", help="no progress bar")
     return parser
 
 
@@ -279,7 +294,19 @@ def _cmd_play(args):
     return 0
 
 
-COMMANDS = {"bots": _cmd_bots, "match": _cmd_match, "tournament": _cmd_tournament,
+def _cmd_train(args):
+    from .train import TrainConfig, train
+
+    config = TrainConfig(opponent=args.opponent, minutes=args.minutes, steps=args.steps,
+                         seed=args.seed, envs=args.envs)
+    result = train(config, args.out, progress=not args.no_progress)
+    print(f"wrote {args.out}: {result['frames']:,} frames, {result['updates']} updates, "
+          f"{result['episodes']} episodes in {result['seconds']:.0f} s; win rate "
+          f"{result['recent_win_rate']:.0%} over the last finished episodes (sampled actions)")
+    return 0
+
+
+COMMANDS = {"train": _cmd_train, "bots": _cmd_bots, "match": _cmd_match, "tournament": _cmd_tournament,
             "replay": _cmd_replay, "play": _cmd_play, "sandbox": _cmd_sandbox}
 
 

@@ -65,6 +65,26 @@ def default_inputs(rules):
                      if name not in ROUND_SCALED], dtype=np.int64)
 
 
+#: the learning observation's entries that are x or y components of a vector (positions,
+#: velocities, headings' cosine and sine): those a half turn about the star negates
+_VECTOR_FIELDS = ("vx", "vy", "cos_heading", "sin_heading", "star_dx", "star_dy", "dx", "dy",
+                  "dvx", "dvy")
+
+
+def seat_signs(rules):
+    """+1 or -1 per learning observation entry: seat 1 seen as seat 0.
+
+    The ships start at opposite corners, seat 1's start being seat 0's turned half way about
+    the star (``core.ship_start``), and the game is the same under that half turn (the star
+    sits at the origin of the torus; a half turn keeps the sense of rotation, so turning left
+    stays left). So seat 1's observation with every vector negated is an observation seat 0
+    could have had, and a policy trained in seat 0 plays seat 1 from it."""
+    from .learning import learning_layout
+
+    return np.array([-1.0 if name.rsplit(".", 1)[-1] in _VECTOR_FIELDS else 1.0
+                     for name in learning_layout(rules)], dtype=np.float32)
+
+
 def codes_from_parts(parts):
     """(K, 4) factor choices (turn, thrust, fire, hyperspace) as game action codes (K,)."""
     parts = np.asarray(parts, dtype=np.int64).reshape(-1, 4)
@@ -257,6 +277,7 @@ class Policy:
         self.inputs = inputs
         self.layers = [(np.asarray(w, np.float32), np.asarray(b, np.float32)) for w, b in layers]
         self._act = _activation(self.activation)
+        self._seat_signs = seat_signs(self.rules)
 
     @classmethod
     def load(cls, path):
@@ -269,12 +290,16 @@ class Policy:
             raise PolicyError(f"cannot read {where}: {exc.strerror or exc}") from None
         return cls(*_parse(_read_npz(io.BytesIO(data), where), where))
 
-    def logits(self, obs):
+    def logits(self, obs, seat=0):
         """The 9 logits (turn 3, thrust 2, fire 2, hyperspace 2) of each row of ``obs``
-        ((K, D) learning observations), float32 (K, 9)."""
+        ((K, D) learning observations of ``seat``), float32 (K, 9)."""
         obs = np.asarray(obs)
         if obs.ndim != 2 or obs.shape[1] != self.observation_length:
             raise ValueError(f"obs must have shape (K, {self.observation_length}), got {obs.shape}")
+        if seat not in (0, 1):
+            raise ValueError(f"seat must be 0 or 1, got {seat!r}")
+        if seat == 1:  # trained in seat 0: seat 1's view turned half way (``seat_signs``)
+            obs = obs * self._seat_signs
         h = obs[:, self.inputs].astype(np.float32, copy=False)
         for i, (w, b) in enumerate(self.layers):
             h = h @ w + b
@@ -282,16 +307,17 @@ class Policy:
                 h = self._act(h)
         return h
 
-    def act_batch(self, obs, greedy=True, rng=None):
+    def act_batch(self, obs, greedy=True, rng=None, seat=0):
         """Game action codes (K,) int64 for learning observations ``obs`` (K, D) float32.
 
         Greedy (each factor's most likely choice) by default; ``greedy=False`` samples each
         factor from its softmax with ``rng`` (a ``numpy.random.Generator``; required, so that
-        sampling is always seeded)."""
+        sampling is always seeded). ``seat=1``: the observations are seat 1's (the policy
+        was trained in seat 0; see ``seat_signs``)."""
         obs = np.asarray(obs)
         if obs.dtype != np.float32:
             raise ValueError(f"obs must be float32 learning observations, got {obs.dtype}")
-        z = self.logits(obs)
+        z = self.logits(obs, seat)
         parts = np.empty((z.shape[0], len(NVEC)), dtype=np.int64)
         if not greedy and not isinstance(rng, np.random.Generator):
             raise ValueError("sampling (greedy=False) needs rng, a numpy.random.Generator")
@@ -315,7 +341,8 @@ class PolicyBot:
     was trained holding each decision that long) and holds the action in between. The
     observation does not say how many rounds the match has, so the entries scaled by it are
     computed with the training value and are not read by the network anyway. ``greedy=False``
-    samples actions from a generator seeded by ``seed``. A match under other rules than the
+    samples actions from a generator seeded by ``seed``. In seat 1 it sees the game turned
+    half way about the star, as seat 0 (``seat_signs``). A match under other rules than the
     policy's is refused (``strict_rules=False`` plays it when the observation length fits)."""
 
     def __init__(self, policy, seed=None, greedy=True, strict_rules=True):
@@ -356,12 +383,48 @@ class PolicyBot:
                                  "observation from")
             x = learning_vector(raw, obs.rules, self.policy.rounds)[None]
             self._held = Action.from_code(int(self.policy.act_batch(
-                x, greedy=self.greedy, rng=self._rng)[0]))
+                x, greedy=self.greedy, rng=self._rng, seat=1 if obs.seat == 1 else 0)[0]))
             self._left = self.policy.frame_skip
         self._left -= 1
         return self._held
 
 
-__all__ = ["Policy", "PolicyBot", "PolicyError", "save_policy", "check_policy_path",
-           "default_inputs", "layout_sha256", "codes_from_parts", "FORMAT", "FORMAT_VERSION",
+def load_policy(path):
+    """``Policy.load(path)``: a validated policy file (the vector env's ``.npz`` opponents)."""
+    return Policy.load(path)
+
+
+def evaluate(policy, opponent="random", matches=50, seed=0, rounds=3, max_frames=20000,
+             greedy=True):
+    """Play ``matches`` matches of ``rounds`` rounds against an opponent of the vector env
+    (``spacewar.envs.OPPONENTS``), all at once, the policy in seat 0 deciding every
+    ``frame_skip`` frames as its bot does; return ``{"wins", "losses", "draws", "matches",
+    "win_rate"}`` (a win: the match's score difference is > 0; a truncated match counts by
+    its score so far). Needs Gymnasium (the ``[rl]`` extra), not JAX."""
+    from .envs import SpacewarVectorEnv
+
+    policy = policy if isinstance(policy, Policy) else Policy.load(policy)
+    env = SpacewarVectorEnv(matches, opponent=opponent, rules=policy.rules, rounds=rounds,
+                            max_frames=max_frames)
+    obs, _ = env.reset(seed=seed)
+    rng = np.random.default_rng([seed, 2])
+    score = np.zeros(matches)
+    over = np.zeros(matches, dtype=bool)
+    parts = None
+    frame = 0
+    while not over.all():
+        if frame % policy.frame_skip == 0:
+            codes = policy.act_batch(obs, greedy=greedy, rng=rng)
+            parts = np.stack([codes % 3, (codes // 3) % 2, (codes // 6) % 2, (codes // 12) % 2], 1)
+        obs, reward, terminated, truncated, _ = env.step(parts)
+        score += np.where(over, 0.0, reward)
+        over |= terminated | truncated
+        frame += 1
+    wins, losses = int(np.sum(score > 0)), int(np.sum(score < 0))
+    return {"wins": wins, "losses": losses, "draws": matches - wins - losses, "matches": matches,
+            "win_rate": wins / matches}
+
+
+__all__ = ["Policy", "PolicyBot", "PolicyError", "load_policy", "save_policy", "check_policy_path", "evaluate",
+           "default_inputs", "layout_sha256", "codes_from_parts", "seat_signs", "FORMAT", "FORMAT_VERSION",
            "NVEC"]

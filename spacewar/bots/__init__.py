@@ -1,4 +1,5 @@
-"""Bots: built-in ones by name, others by ``package.module:Class`` or ``path/to/file.py:Class``.
+"""Bots: built-in ones by name, others by ``package.module:Class`` or ``path/to/file.py:Class``;
+a trained policy by its ``.npz`` file (``spacewar.policy.PolicyBot``).
 
 A bot is any class with ``act(self, obs) -> spacewar.Action``; it may define ``reset(self)``
 (called when a match starts) and accept a ``seed`` keyword (built-in bots do).
@@ -29,8 +30,15 @@ def available():
     return sorted(BUILTIN)
 
 
+def is_policy_file(spec):
+    """Whether ``spec`` names a trained policy file (``*.npz``, see ``spacewar.policy``)."""
+    return isinstance(spec, str) and spec.lower().endswith(".npz")
+
+
 def is_builtin(spec):
-    return isinstance(spec, str) and spec in BUILTIN
+    """A built-in bot, or a policy file: data that our own code (``spacewar.policy``) reads
+    without pickle and validates, so it plays in this process like a built-in bot."""
+    return isinstance(spec, str) and (spec in BUILTIN or is_policy_file(spec))
 
 
 def _split(spec):
@@ -59,6 +67,11 @@ def locate(spec):
     a bot: unknown name, missing file, module not found. Whether the module imports, and has
     the class, is learnt in the bot's own process.
     """
+    if is_policy_file(spec):
+        path = os.path.abspath(spec)
+        if not os.path.isfile(path):
+            raise BotLoadError(f"policy file {spec!r} does not exist")
+        return [path], [], None
     where, _ = _split(spec)
     if is_builtin(spec):
         return [], [], None
@@ -94,6 +107,8 @@ def locate(spec):
 
 def absolute_spec(spec):
     """``spec`` with a bot file's path made absolute (a bot's process starts elsewhere)."""
+    if is_policy_file(spec):
+        return os.path.abspath(spec)
     where, class_name = _split(spec)
     if not is_builtin(spec) and _is_file_spec(where):
         return f"{os.path.abspath(where)}:{class_name}"
@@ -134,13 +149,21 @@ def load_bot_class(spec):
         cls, origin = getattr(module, class_name, None), where
     if cls is None:
         raise BotLoadError(f"{origin!r} has no class {class_name!r}")
-    if not callable(getattr(cls, "act", None)):
-        raise BotLoadError(f"{spec!r} is not a bot: it has no act(self, obs) method")
+    if not callable(getattr(cls, "act", None)) and not callable(getattr(cls, "act_batch", None)):
+        raise BotLoadError(f"{spec!r} is not a bot: it has neither act(self, obs) nor "
+                           "act_batch(self, obs) (spacewar.batch_bots)")
     return cls
 
 
 def make_bot(spec, seed=None):
     """An instance of the bot ``spec``, given ``seed`` if its constructor takes one."""
+    if is_policy_file(spec):
+        from ..policy import PolicyBot, PolicyError
+
+        try:
+            return PolicyBot(spec, seed=seed)
+        except PolicyError as exc:
+            raise BotLoadError(str(exc)) from None
     cls = load_bot_class(spec)
     try:
         params = inspect.signature(cls).parameters
