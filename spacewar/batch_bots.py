@@ -83,9 +83,12 @@ class SingleFromBatch:
     score and round count by it)."""
 
     def __init__(self, bot, rules, rounds):
+        from .learning import learning_vector  # imported now, in the bot's start-up time
+
         self.bot = bot
         self.rules = rules
         self.rounds = int(rounds)
+        self._vector = learning_vector
 
     def reset(self):
         reset = getattr(self.bot, "reset", None)
@@ -94,11 +97,8 @@ class SingleFromBatch:
 
     def answer(self, obs):
         """``(status, code, text)`` as ``spacewar.wire.ask`` gives for a bot with ``act``."""
-        from .learning import learning_vector
-
-        raw = object.__getattribute__(obs, "_raw")
-        status, answer, text = ask_batch(self.bot, learning_vector(raw, self.rules,
-                                                                   self.rounds)[None])
+        row = self._vector(obs.raw(), self.rules, self.rounds)[None]
+        status, answer, text = ask_batch(self.bot, row)
         return status, int(answer[0]), text
 
     def act(self, obs):

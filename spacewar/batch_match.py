@@ -10,6 +10,9 @@ one instance for all of its matches; every other bot, a built-in one, gets its o
 per match and seat, as in a match alone. Bots from files are not played here: they run in
 their own confined process, one match at a time (``play_match``).
 
+A bot with both ``act`` and ``act_batch`` plays ``act_batch`` here and ``act`` alone: the
+results are the same when the two agree.
+
 Faults are those of a match alone, counted per match and seat. A batch bot's call is timed
 as a whole and each live match charged its share against that match's budget; when it
 raises or answers anything but one valid code per row, each of its live matches records the
@@ -28,33 +31,8 @@ from .match import (DEFAULT_BUDGET, DEFAULT_MAX_FAULTS, FaultLog, _cpu_seconds, 
                     bot_seed)
 from .protocol import raw_length
 from .rules import Rules
-from .seats import Limits, bot_name, open_seat
-from .wire import MEMORY, OK, RAISED
-
-_FAULT_OF_STATUS = {RAISED: "raised", MEMORY: "memory"}
-
-
-class PolicyBatch:
-    """A policy file as a batch bot: ``Policy.act_batch`` on every row, each decision held
-    ``frame_skip`` frames as ``spacewar.policy.PolicyBot`` holds it in a match alone (the
-    rows' matches all start together, so one call counter serves them all)."""
-
-    def __init__(self, path):
-        from .policy import Policy
-
-        self.policy = Policy.load(path)
-        self.name = path
-        self.reset()
-
-    def reset(self):
-        self._held = None
-        self._calls = 0
-
-    def act_batch(self, obs):
-        if self._calls % self.policy.frame_skip == 0:
-            self._held = self.policy.act_batch(obs)
-        self._calls += 1
-        return self._held
+from .seats import _KIND_BY_STATUS, Limits, bot_name, open_seat
+from .wire import INVALID, OK, exception_text
 
 
 def is_batch_spec(spec):
@@ -68,22 +46,25 @@ def can_play_together(spec):
 
 
 class _BatchSide:
-    """One batch bot and the (match, seat) rows it plays, in match order."""
+    """One batch bot and the (match, seat) rows it plays, in match order. A policy file is
+    ``spacewar.policy.PolicyBatch``: each row played as ``PolicyBot`` plays that match."""
 
-    def __init__(self, spec, rows):
+    def __init__(self, spec, rows, rules):
         self.spec = spec
-        self.bot = PolicyBatch(spec) if isinstance(spec, str) else spec
         self.rows = rows  # list of (m, seat)
         self.index = (np.array([m for m, _ in rows]), np.array([s for _, s in rows]))
-        reset = getattr(self.bot, "reset", None)
         self.dead = None
-        if callable(reset):
-            try:
-                reset()
-            except BaseException as exc:  # the caller's code: a fault, not a crash
-                from .wire import exception_text
+        self.bot = spec
+        try:
+            if isinstance(spec, str):
+                from .policy import PolicyBatch
 
-                self.dead = ("startup", exception_text(exc))
+                self.bot = PolicyBatch(spec, rules, [s for _, s in rows])
+            reset = getattr(self.bot, "reset", None)
+            if callable(reset):
+                reset()
+        except BaseException as exc:  # a bad file, or the caller's reset: a fault, not a crash
+            self.dead = ("startup", exception_text(exc))
 
 
 def play_matches(matches, rounds=5, rules=None, budget=DEFAULT_BUDGET,
@@ -92,6 +73,11 @@ def play_matches(matches, rounds=5, rules=None, budget=DEFAULT_BUDGET,
     ``(result, timing)``, one per match in order, ``result`` as ``play_match`` gives it."""
     rules = Rules() if rules is None else rules
     matches = [tuple(x) for x in matches]
+    if not matches:
+        raise ValueError("matches must hold at least one (p1, p2, seed)")
+    for match in matches:
+        if len(match) != 3:
+            raise ValueError(f"each match must be (p1, p2, seed), got {match!r:.200}")
     for p1, p2, seed in matches:
         for spec in (p1, p2):
             if not can_play_together(spec):
@@ -191,32 +177,34 @@ def _open(matches, limits, rules, rounds):
             else:
                 seats[m][s] = open_seat(spec, bot_seed(seed, s), limits, rules, "auto", cpu,
                                         rounds=rounds)
-    return [_BatchSide(spec, rows) for spec, rows in sides.values()], seats
+    return [_BatchSide(spec, rows, rules) for spec, rows in sides.values()], seats
 
 
 def _ask_side(side, learning, live, match_state, actions, faults, banks):
     """The batch bot's codes for all its rows (a no-op and a fault on each live row when its
-    answer is not usable)."""
+    answer is not usable), judged in the order of a match alone (``InlineSeat.act``): no
+    answer at all (raised, out of memory) costs no time; a late answer is a timeout, whatever
+    it holds; an answer in time that is not K valid codes is invalid."""
     ms, ss = side.index
-    obs = learning[ms, ss]
-    start = time.perf_counter()
-    status, codes, text = ask_batch(side.bot, obs)
-    elapsed = time.perf_counter() - start
     alive = live[ms]
-    share = elapsed / max(int(alive.sum()), 1)
+    if side.dead is not None or not alive.any():
+        return  # nothing of it to play: not asked (its finished rows' actions are ignored)
+    start = time.perf_counter()
+    status, codes, text = ask_batch(side.bot, learning[ms, ss])
+    share = (time.perf_counter() - start) / int(alive.sum())
     for k, (m, s) in enumerate(side.rows):
         if not alive[k]:
             continue
         frame = int(match_state[m, core.FRAME])
-        if status != OK:
-            kind = _FAULT_OF_STATUS.get(status, "invalid")
-            faults[m][s].add(frame, kind, text)
-            actions[m, s] = core.NOOP
+        actions[m, s] = core.NOOP
+        if status in _KIND_BY_STATUS and status != INVALID:
+            faults[m][s].add(frame, _KIND_BY_STATUS[status], text)
         elif not banks[m][s].charge(share):
             faults[m][s].add(frame, "timeout", banks[m][s].late(share))
-            actions[m, s] = core.NOOP
+        elif status != OK:
+            faults[m][s].add(frame, _KIND_BY_STATUS[status], text)
         else:
             actions[m, s] = codes[k]
 
 
-__all__ = ["play_matches", "PolicyBatch", "is_batch_spec", "can_play_together"]
+__all__ = ["play_matches", "is_batch_spec", "can_play_together"]

@@ -14,7 +14,7 @@ Description
     seats learn: the agent axis is then 2 * matches, match m's seats at 2m and 2m + 1).
 Action space
     ``MultiDiscrete([3, 2, 2, 2])`` (``action_type="multi_discrete"``, the default): turn (0
-    right, 1 none, 2 left, i.e. turn - 1 of ``spacewar.Action``), thrust, fire, hyperspace;
+    right, 1 none, 2 left, i.e. ``spacewar.Action.turn + 1``), thrust, fire, hyperspace;
     in the electric mode a fifth entry, the polarity flip, ``MultiDiscrete([3, 2, 2, 2, 2])``.
     ``action_type="discrete"``: ``Discrete(24)`` (48 in the electric mode), the game's own
     action code ``turn + 3 thrust + 6 fire + 12 hyperspace + 24 flip``.
@@ -64,8 +64,10 @@ except ImportError as error:  # pragma: no cover - the extra is missing
     raise ImportError("spacewar.envs needs Gymnasium: pip install -e '.[rl]'") from error
 
 from . import core
+from .codes import codes_from_parts
 from .learning import LearningBatch, learning_layout, learning_length, seat_kinds
 from .learning import compiled_bots
+from .batch_bots import checked_codes
 from .protocol import action_code
 from .rules import Rules
 
@@ -106,43 +108,29 @@ def observation_space(rules):
     return spaces.Box(low, high, dtype=np.float32)
 
 
-def codes_from_parts(parts):
-    """(K, 4) or (K, 5) MultiDiscrete actions as the game's action codes (K,)."""
-    parts = np.asarray(parts, dtype=np.int64)
-    width = parts.shape[-1] if parts.ndim else 0
-    if width not in (4, 5):
-        raise ValueError(f"MultiDiscrete actions have 4 or 5 parts, got shape {parts.shape}")
-    parts = parts.reshape(-1, width)
-    codes = parts[:, 0] + 3 * parts[:, 1] + 6 * parts[:, 2] + 12 * parts[:, 3]
-    if width == 5:
-        codes = codes + 24 * parts[:, 4]
-    return codes
-
-
 def _check(name, value, allowed):
     if not isinstance(value, (str, type(None))) or value not in allowed:
         raise ValueError(f"{name} must be one of {', '.join(map(repr, allowed))}, got {value!r}")
     return value
 
 
-def _load_policy(path):
-    from .policy import load_policy
-
-    return load_policy(path)
-
-
 class _Opponent:
     """Seat 1's player as the vector env drives it: compiled (inside the batch), a batch
     policy (seat 1's observations in, codes out) or a Python bot (one match)."""
 
-    def __init__(self, opponent, num_envs):
+    def __init__(self, opponent, num_envs, rules):
+        from .bots import is_policy_file
+
         self.compiled = None
         self.policy = None
         self.bot = None
         if opponent is None or isinstance(opponent, str) and opponent in compiled_bots.KINDS:
             self.compiled = opponent
-        elif isinstance(opponent, (str, os.PathLike)) and str(opponent).endswith(".npz"):
-            self.policy = _load_policy(opponent)
+        elif isinstance(opponent, (str, os.PathLike)) and is_policy_file(os.fspath(opponent)):
+            from .policy import PolicyBatch
+
+            # seat 1's rows, each held frame_skip frames: as PolicyBot plays each match
+            self.policy = PolicyBatch(os.fspath(opponent), rules, np.ones(num_envs, np.int64))
         elif hasattr(opponent, "act_batch"):
             self.policy = opponent
         elif hasattr(opponent, "act"):
@@ -159,20 +147,22 @@ class _Opponent:
     def codes(self, batch):
         """Seat 1's codes for the coming frame (None when the batch decides them)."""
         if self.policy is not None:
-            codes = np.asarray(self.policy.act_batch(batch.observations[:, 1]))
-            if codes.shape != (batch.game.n_matches,) or codes.dtype.kind not in "iu" \
-                    or codes.min() < 0 or codes.max() >= core.N_ACTIONS:
-                raise ValueError(f"the opponent policy's act_batch must give "
-                                 f"({batch.game.n_matches},) action codes in [0, "
-                                 f"{core.N_ACTIONS}), got {codes.dtype} {codes.shape}")
-            return codes
+            answer = self.policy.act_batch(batch.observations[:, 1])
+            try:
+                return checked_codes(answer, batch.game.n_matches)
+            except ValueError as exc:
+                raise ValueError(f"the opponent policy's act_batch: {exc}") from None
         if self.bot is not None:
             return np.array([action_code(self.bot.act(batch.game.observe(0, 1)))])
         return None
 
-    def episode_started(self):
+    def episode_started(self, mask=None):
+        """The matches of ``mask`` (all if None) start again."""
         if self.bot is not None and hasattr(self.bot, "reset"):
             self.bot.reset()
+        restart = getattr(self.policy, "restart", None)
+        if restart is not None:
+            restart(np.ones(len(self.policy.seats), bool) if mask is None else mask)
 
 
 class SpacewarVectorEnv(VectorEnv):
@@ -195,13 +185,16 @@ class SpacewarVectorEnv(VectorEnv):
         self.metadata = {**type(self).metadata, "autoreset_mode": _AUTORESET[self.autoreset]}
         self.render_mode = None
         self.rules = Rules() if rules is None else rules
-        self.rounds = rounds
-        self.max_frames = max_frames
+        for name, value, low in (("rounds", rounds, 1), ("max_frames", max_frames, 0)):
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < low:
+                raise ValueError(f"{name} must be an int >= {low}, got {value!r}")
+        self.rounds = int(rounds)
+        self.max_frames = int(max_frames)
         self.self_play = opponent is None
         if self.self_play and num_envs % 2:
             raise ValueError(f"self-play (opponent=None) needs an even num_envs (two seats a "
                              f"match), got {num_envs}")
-        self._opponent = _Opponent(opponent, num_envs)
+        self._opponent = _Opponent(opponent, num_envs, self.rules)
         self.opponent = opponent
         self.matches = int(num_envs) // 2 if self.self_play else int(num_envs)
         self.num_envs = int(num_envs)
@@ -239,12 +232,14 @@ class SpacewarVectorEnv(VectorEnv):
                                  "without reset_mask")
             if self._batch is None:
                 raise RuntimeError("call reset() without a reset_mask first")
-            self._batch.reset(self._match_mask(mask))
+            mask = self._match_mask(mask)
+            self._batch.reset(mask)
+            self._opponent.episode_started(mask)
         else:
             if seed is not None or self._batch is None:
                 self._new_batch(seed)
             self._batch.reset()
-        self._opponent.episode_started()
+            self._opponent.episode_started()
         return self._out(self._view(self._batch.observations)), {}
 
     def _out(self, array):
@@ -286,8 +281,9 @@ class SpacewarVectorEnv(VectorEnv):
         infos = {}
         if self.autoreset == "same_step" and batch.ended.any():
             infos = self._final_infos(batch)
-        if self._opponent.bot is not None and batch.episodes[0] != episodes[0]:
-            self._opponent.episode_started()
+        restarted = batch.episodes != episodes
+        if restarted.any():
+            self._opponent.episode_started(restarted)
         return (self._out(self._view(obs)), self._view(rewards).astype(np.float64),
                 self._per_agent(terminated), self._per_agent(truncated), infos)
 

@@ -29,7 +29,7 @@ from engine import space
 from engine.state import Model, State, Workspace
 
 from . import compiled_bots, core
-from .protocol import raw_layout, raw_length
+from .protocol import raw_layout
 from .rules import Rules
 
 jit = core.jit
@@ -326,7 +326,8 @@ class LearningBatch:
     (Gymnasium's default), ``"same_step"`` (``final_observations`` and ``ended`` tell the
     matches that ended) or ``"disabled"`` (``reset(mask)``). ``opponents``: per seat, None
     for actions given to ``step``, or the name of a compiled bot (``compiled_bots.KINDS``)
-    that decides inside the compiled call."""
+    that decides inside the compiled call; a compiled seat's rows of ``observations`` are
+    not written (they stay zeros)."""
 
     def __init__(self, matches, rules=None, seed=0, rounds=3, frame_cap=0,
                  autoreset="next_step", opponents=(None, None)):
@@ -392,9 +393,13 @@ class LearningBatch:
             if mask.shape != self.pending.shape or mask.dtype != np.bool_:
                 raise ValueError(f"mask must be a bool array of shape {self.pending.shape}, got "
                                  f"{mask.dtype} {mask.shape}")
-        self.pending |= mask
+            if not mask.any():
+                raise ValueError("mask must select at least one match to reset, got none")
+        later = self.pending & ~mask  # ended, outside the mask: restarted by the next step
+        self.pending[:] = mask
         self._awaiting &= ~mask
         self._call(False)
+        self.pending |= later
         return self.observations
 
     def _call(self, play):
@@ -408,7 +413,8 @@ class LearningBatch:
 
     @property
     def actions(self):
-        """The (M, 2) action codes of the last frame, the compiled bots' included."""
+        """The (M, 2) action codes of the last frame played, the compiled bots' included (a
+        match restarted by the last call keeps its previous frame's)."""
         return self._codes
 
 
@@ -465,58 +471,7 @@ def learning_vector(raw, rules, rounds):
     return np.array(out, dtype=np.float32)
 
 
-def learning_vectors(raws, rules, rounds):
-    """``learning_vector`` of each row of ``raws`` ((K, raw length) raw observations) at once,
-    vectorised in NumPy: (K, D) float32, the same numbers (a batch bot's process computes
-    these from the raw observations it is sent)."""
-    raws = np.asarray(raws, dtype=np.float64)
-    n = raw_length(rules)
-    if raws.ndim != 2 or raws.shape[1] != n:
-        raise ValueError(f"raws must have shape (K, {n}), got {raws.shape}")
-    index = {name: k for k, name in enumerate(raw_layout(rules))}
-    s = learning_scales(rules, rounds)
-    sp, sv = s[2], s[3]
-
-    def col(name):
-        return raws[:, index[name]]
-
-    def rel(d):
-        return space.nearest_image(d, 1.0) * sp
-
-    x0, y0, vx0, vy0 = col("me.x"), col("me.y"), col("me.vx"), col("me.vy")
-    out = np.empty((raws.shape[0], learning_length(rules)))
-    head = [col("round_frame") * s[0], col("round") * s[1],
-            (col("score_me") - col("score_enemy")) * s[1],
-            (col("star_mu") > 0.0).astype(np.float64), col("star_mu") * s[12],
-            np.full(raws.shape[0], s[13])]
-    own = [vx0 * sv, vy0 * sv, np.cos(col("me.heading")), np.sin(col("me.heading")),
-           col("me.angular_velocity") * s[4], col("me.fuel") * s[5], col("me.torpedoes") * s[6],
-           col("me.hyperspace") * s[7], col("me.alive"), col("me.in_hyperspace"),
-           col("me.reload") * s[8], col("me.hyperspace_recharge") * s[9],
-           np.sign(col("me.charge")), col("me.flip_cooldown") * s[10]]
-    star = [rel(0.0 - x0), rel(0.0 - y0)]
-    enemy = [rel(col("enemy.x") - x0), rel(col("enemy.y") - y0), (col("enemy.vx") - vx0) * sv,
-             (col("enemy.vy") - vy0) * sv, np.cos(col("enemy.heading")),
-             np.sin(col("enemy.heading")), col("enemy.angular_velocity") * s[4],
-             col("enemy.fuel") * s[5], col("enemy.torpedoes") * s[6],
-             col("enemy.hyperspace") * s[7], col("enemy.alive"), col("enemy.in_hyperspace"),
-             np.sign(col("enemy.charge"))]
-    for k, column in enumerate(head + own + star + enemy):
-        out[:, k] = column
-    k = _TORPEDOES
-    for t in range(2 * rules.torpedoes):
-        present = col(f"torpedo{t}.present") != 0.0
-        rows = [np.ones(raws.shape[0]), rel(col(f"torpedo{t}.x") - x0),
-                rel(col(f"torpedo{t}.y") - y0), (col(f"torpedo{t}.vx") - vx0) * sv,
-                (col(f"torpedo{t}.vy") - vy0) * sv, col(f"torpedo{t}.ttl") * s[11]]
-        for j, column in enumerate(rows):
-            out[:, k + j] = np.where(present, column, 0.0)
-        k += _NT
-    return out.astype(np.float32)
-
-
 __all__ = ["learning_layout", "learning_length", "learning_scales", "learning_vector",
-           "learning_vectors",
            "write_learning", "write_all_learning", "episode_stream", "step_learning",
            "LearningBatch", "seat_kinds", "AUTORESET_MODES", "NEXT_STEP", "SAME_STEP", "DISABLED",
            "EXTERNAL"]

@@ -226,7 +226,7 @@ def play(p2="chaser", rules=None, seed=0, rounds=5, fps=60, scale=720, script=No
     from engine.clock import FixedStepClock
 
     game = Game(rules, seeds=[seed], rounds=rounds)  # checks seed and rounds
-    seat = open_seat(p2, bot_seed(seed, 1), Limits(budget=BOT_BUDGET), rules)
+    seat = open_seat(p2, bot_seed(seed, 1), Limits(budget=BOT_BUDGET), rules, rounds=rounds)
     if getattr(seat, "wait_ready", None) is not None and seat.wait_ready() is not None:
         seat.close()
         raise ValueError(f"bot {p2!r} could not start: {seat.dead[1]}")

@@ -33,6 +33,8 @@ import zipfile
 
 import numpy as np
 
+from .codes import codes_from_parts
+
 FORMAT = "spacewar-policy"
 FORMAT_VERSION = 1
 NVEC = (3, 2, 2, 2)
@@ -45,7 +47,6 @@ MAX_ELEMENTS = 1 << 26  # no policy array is larger than 64 Mi numbers (256 MiB 
 MAX_LAYERS = 16
 MAX_FRAME_SKIP = 64
 _OFFSETS = np.cumsum((0,) + NVEC)  # where each factor's logits start
-_WEIGHTS = tuple(int(w) for w in (1, 3, 6, 12))  # game code = turn + 3 thrust + 6 fire + 12 hyperspace
 
 
 class PolicyError(ValueError):
@@ -83,12 +84,6 @@ def seat_signs(rules):
 
     return np.array([-1.0 if name.rsplit(".", 1)[-1] in _VECTOR_FIELDS else 1.0
                      for name in learning_layout(rules)], dtype=np.float32)
-
-
-def codes_from_parts(parts):
-    """(K, 4) factor choices (turn, thrust, fire, hyperspace) as game action codes (K,)."""
-    parts = np.asarray(parts, dtype=np.int64).reshape(-1, 4)
-    return parts @ np.array(_WEIGHTS, dtype=np.int64)
 
 
 # -- saving ---------------------------------------------------------------------------------
@@ -359,15 +354,7 @@ class PolicyBot:
         self._checked = False
 
     def _check_rules(self, rules):
-        mine, theirs = self.policy.rules.to_dict(), rules.to_dict()
-        if mine != theirs:
-            diff = {k: (mine.get(k), theirs.get(k)) for k in sorted(set(mine) | set(theirs))
-                    if mine.get(k) != theirs.get(k)}
-            from .learning import learning_length
-
-            if self.strict_rules or learning_length(rules) != self.policy.observation_length:
-                raise ValueError(f"the policy was trained under other rules (field: "
-                                 f"(policy's, match's) = {diff})")
+        check_rules(self.policy, rules, self.strict_rules)
         self._checked = True
 
     def act(self, obs):
@@ -387,6 +374,56 @@ class PolicyBot:
             self._left = self.policy.frame_skip
         self._left -= 1
         return self._held
+
+
+def check_rules(policy, rules, strict=True):
+    """Raise ValueError naming the fields unless ``policy`` may play under ``rules``: the
+    rules it was trained under (or, not ``strict``, any with the same observation length)."""
+    mine, theirs = policy.rules.to_dict(), rules.to_dict()
+    if mine != theirs:
+        diff = {k: (mine.get(k), theirs.get(k)) for k in sorted(set(mine) | set(theirs))
+                if mine.get(k) != theirs.get(k)}
+        from .learning import learning_length
+
+        if strict or learning_length(rules) != policy.observation_length:
+            raise ValueError(f"the policy was trained under other rules (field: "
+                             f"(policy's, match's) = {diff})")
+
+
+class PolicyBatch:
+    """A policy as a batch bot (``spacewar.batch_bots``) for rows whose seats are known: each
+    row decides every ``frame_skip`` frames and holds its action in between, seat 1's rows
+    seen turned half way (``seat_signs``), greedily: row by row what ``PolicyBot`` plays in
+    that row's match, however many rows are decided together. ``restart(mask)``: those rows'
+    matches start again (their next call decides). Under other rules than the policy's every
+    call raises, as ``PolicyBot.act`` does."""
+
+    def __init__(self, policy, rules, seats, strict_rules=True):
+        self.policy = policy if isinstance(policy, Policy) else Policy.load(policy)
+        self.rules = rules
+        self.seats = np.asarray(seats, dtype=np.int64)
+        if self.seats.ndim != 1 or not np.isin(self.seats, (0, 1)).all():
+            raise ValueError(f"seats must be a list of 0 and 1, got {seats!r}")
+        self.strict_rules = strict_rules
+        self._held = np.zeros(len(self.seats), dtype=np.int64)
+        self._left = np.zeros(len(self.seats), dtype=np.int64)
+
+    def reset(self):
+        self._left[:] = 0
+
+    def restart(self, mask):
+        self._left[np.asarray(mask, dtype=bool)] = 0
+
+    def act_batch(self, obs):
+        check_rules(self.policy, self.rules, self.strict_rules)
+        due = self._left == 0
+        for seat in (0, 1):
+            rows = np.flatnonzero(due & (self.seats == seat))
+            if rows.size:
+                self._held[rows] = self.policy.act_batch(obs[rows], seat=seat)
+        self._left[due] = self.policy.frame_skip
+        self._left -= 1
+        return self._held.copy()
 
 
 def load_policy(path):
@@ -425,6 +462,6 @@ def evaluate(policy, opponent="random", matches=50, seed=0, rounds=3, max_frames
             "win_rate": wins / matches}
 
 
-__all__ = ["Policy", "PolicyBot", "PolicyError", "load_policy", "save_policy", "check_policy_path", "evaluate",
+__all__ = ["Policy", "PolicyBot", "PolicyBatch", "check_rules", "PolicyError", "load_policy", "save_policy", "check_policy_path", "evaluate",
            "default_inputs", "layout_sha256", "codes_from_parts", "seat_signs", "FORMAT", "FORMAT_VERSION",
            "NVEC"]

@@ -136,6 +136,10 @@ class Observation:
     _raw: np.ndarray = field(repr=False, default=None, compare=False)
     _scales: tuple = field(repr=False, default=None, compare=False)
 
+    def raw(self):
+        """The flat raw observation this one was made from (``raw_layout``), read-only."""
+        return object.__getattribute__(self, "_raw")
+
     def vector(self):
         """A flat float64 vector of fixed length (see ``vector_layout``), for learning code."""
         if self._vector is None and self._raw is not None:  # made on first use only

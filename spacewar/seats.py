@@ -36,7 +36,7 @@ import time
 
 from . import codes, confinement, wire
 from .batch_bots import SingleFromBatch, is_batch_bot
-from .bots import absolute_spec, is_builtin, locate, make_bot
+from .bots import BotLoadError, absolute_spec, is_builtin, locate, make_bot
 from .protocol import observation_from_raw
 
 FAULT_KINDS = ("raised", "invalid", "timeout", "crashed", "startup", "memory")
@@ -132,7 +132,11 @@ class InlineSeat:
         self.bank = _Bank(limits)
         self.dead = None
         self.layers = ["in this process (built-in bot or the caller's bot object)"]
-        self.bot = make_bot(spec, seed=seed) if bot is None else bot
+        try:
+            self.bot = make_bot(spec, seed=seed) if bot is None else bot
+        except BotLoadError as exc:  # a policy file that is not a valid policy
+            self.bot, self.dead = None, ("startup", str(exc))
+            return
         if is_batch_bot(self.bot) and not callable(getattr(self.bot, "act", None)):
             self.bot = SingleFromBatch(self.bot, self._rules, DEFAULT_ROUNDS if rounds is None
                                        else rounds)

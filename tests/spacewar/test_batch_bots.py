@@ -153,3 +153,64 @@ def test_a_batch_bot_from_a_file_plays_in_its_confined_process(tmp_path):
 def test_only_bots_that_can_share_a_game_are_played_together(tmp_path):
     with pytest.raises(ValueError, match="plays with play_match"):
         play_matches([("tests.spacewar.hostile_bots:Crasher", "idle", 1)], rules=SHORT)
+
+
+@pytest.fixture(scope="module")
+def policy_file(tmp_path_factory):
+    pytest.importorskip("jax")
+    from spacewar import train
+
+    config = train.TrainConfig(seed=3)
+    path = str(tmp_path_factory.mktemp("policy") / "policy.npz")
+    params = train.initial_params(config)
+    train.save_params(path, params, config)
+    return path
+
+
+def test_a_policy_file_plays_together_as_its_bot_plays_alone(policy_file):
+    from spacewar.policy import PolicyBot
+
+    jobs = [(policy_file, "chaser", 1), ("chaser", policy_file, 1),
+            (policy_file, policy_file, 2), ("idle", policy_file, 3)]
+    together = play_matches(jobs, rounds=1)
+    for (result, _), (p1, p2, seed) in zip(together, jobs):
+        alone, _, _ = play_match(p1, p2, seed=seed, rounds=1)
+        assert _same(result, alone), (p1, p2)
+    other = Rules(max_round_frames=400)  # not the rules it was trained under
+    bad = play_matches([(policy_file, "idle", 4)], rules=other, rounds=1, max_faults=5)[0][0]
+    alone, _, _ = play_match(policy_file, "idle", seed=4, rules=other, rounds=1, max_faults=5)
+    assert _same(bad, alone) and bad["forfeits"][0] and "other rules" in \
+        bad["faults"][0]["examples"][0]["message"]
+    assert PolicyBot(policy_file).policy.frame_skip > 1  # the holding is exercised
+
+
+def test_a_policy_file_is_the_envs_opponent_as_its_bot_would_play(policy_file, tmp_path):
+    pytest.importorskip("gymnasium")
+    import shutil
+
+    from spacewar import envs
+    from spacewar.policy import PolicyBot
+    from spacewar.protocol import action_code
+
+    shouting = str(tmp_path / "POLICY.NPZ")  # the suffix is found whatever its case
+    shutil.copy(policy_file, shouting)
+    vec = envs.SpacewarVectorEnv(3, opponent=shouting, max_frames=30)
+    vec.reset(seed=2)
+    bots = [PolicyBot(policy_file) for _ in range(3)]
+    rng = np.random.default_rng(4)
+    ended = np.zeros(3, dtype=bool)
+    played = 0
+    for _ in range(70):  # past two truncations: the bots restart with their matches
+        game = vec.batch.game
+        if ended.all():  # this step restarts the matches (next-step autoreset)
+            vec.step(rng.integers(0, [3, 2, 2, 2], size=(3, 4)))
+            for bot in bots:
+                bot.reset()
+            ended[:] = False
+            continue
+        expected = [action_code(bots[m].act(game.observe(m, 1))) for m in range(3)]
+        *_, terminated, truncated, _ = vec.step(rng.integers(0, [3, 2, 2, 2], size=(3, 4)))
+        assert vec.batch.actions[:, 1].tolist() == expected
+        ended = terminated | truncated
+        played += 1
+    assert played == 68

@@ -35,6 +35,7 @@ def test_same_step_autoreset_returns_the_next_episode_and_the_final_observation(
             ends += 1
             # the ended episode's last observation is what next-step mode shows now ...
             assert info["_final_obs"].tolist() == u_ref.tolist()
+            assert info["final_info"] == {} and info["_final_info"].tolist() == u_ref.tolist()
             for e in np.flatnonzero(u_ref):
                 np.testing.assert_array_equal(info["final_obs"][e], o_ref[e])
             # ... and same-step already shows the next episode, which next-step shows next
@@ -123,7 +124,7 @@ def test_a_batch_policy_plays_every_match_from_seat_ones_observations():
     assert len(policy.calls) == 3 and policy.calls[0].dtype == np.float32
     bad = envs.SpacewarVectorEnv(2, opponent=_Constant(99), max_frames=50)
     bad.reset(seed=0)
-    with pytest.raises(ValueError, match="act_batch must give"):
+    with pytest.raises(ValueError, match="act_batch: action code 99 out of range"):
         bad.step(np.ones((2, 4), dtype=np.int64))
 
 
@@ -217,3 +218,52 @@ def test_copy_false_returns_the_batchs_own_buffers_with_the_same_numbers():
         a = copied.step(p)[0]
         b = shared.step(p)[0]
         np.testing.assert_array_equal(a, b)
+
+
+def test_a_reset_mask_under_next_step_autoreset_restarts_only_the_masked_matches():
+    ref, vec, actions, _, _ = _lockstep("next_step", CAP + 2)
+    for a in actions[:CAP]:
+        ref.step(a)
+        obs, *_ = vec.step(a)
+    before = vec.batch.episodes.copy()
+    with pytest.raises(ValueError, match="at least one"):
+        vec.reset(options={"reset_mask": np.zeros(3, dtype=bool)})
+    again, _ = vec.reset(options={"reset_mask": np.array([True, False, False])})
+    assert (vec.batch.episodes - before).tolist() == [1, 0, 0]
+    np.testing.assert_array_equal(again[1:], obs[1:])  # not restarted yet ...
+    after, reward, *_ = vec.step(actions[CAP])
+    restarted, *_ = ref.step(actions[CAP])
+    np.testing.assert_array_equal(after[1:], restarted[1:])  # ... but at the next step
+    assert (reward[1:] == 0).all() and (vec.batch.episodes - before).tolist() == [1, 1, 1]
+
+
+def test_more_matches_than_chunks_give_the_same_games():
+    from spacewar.learning import CHUNKS, LearningBatch
+
+    few = LearningBatch(12, seed=6, frame_cap=500, opponents=("chaser", "sniper"))
+    many = LearningBatch(CHUNKS + 44, seed=6, frame_cap=500, opponents=("chaser", "sniper"))
+    for _ in range(60):
+        few.step()
+        many.step()
+    np.testing.assert_array_equal(few.actions, many.actions[:12])
+    for name in ("pos", "vel"):
+        np.testing.assert_array_equal(getattr(few.game, name), getattr(many.game, name)[:12])
+
+
+def test_a_python_bot_opponent_s_actions_are_played():
+    from spacewar.protocol import action_code
+
+    twin = Chaser()
+    env = envs.SpacewarEnv(opponent=Chaser(), max_frames=100)
+    env.reset(seed=3)
+    for _ in range(80):
+        expected = action_code(twin.act(env.game.observe(0, 1)))
+        env.step(env.action_space.sample())
+        assert env._vector.batch.actions[0, 1] == expected
+
+
+@pytest.mark.parametrize("field, value", [("max_frames", -1), ("max_frames", 2.5),
+                                          ("rounds", 0)])
+def test_bad_lengths_are_refused_at_construction(field, value):
+    with pytest.raises(ValueError, match=f"{field} must be an int"):
+        envs.SpacewarVectorEnv(2, **{field: value})
