@@ -54,7 +54,8 @@ def ask_batch(bot, obs):
 def checked_codes(answer, k):
     """``answer`` as (k,) int64 action codes, or ValueError saying why it is not."""
     if isinstance(answer, np.ndarray):
-        array = answer
+        # a plain copy of its memory: a subclass's own methods (astype, indexing) never run
+        array = np.array(answer, copy=True, subok=False)
     elif isinstance(answer, (list, tuple)):
         if len(answer) != k or not all(type(x) in _INT_TYPES for x in answer):
             raise ValueError(f"act_batch must return {k} integer action codes")
@@ -65,11 +66,10 @@ def checked_codes(answer, k):
     if array.shape != (k,) or array.dtype.kind not in "iu":
         raise ValueError(f"act_batch must return {k} integer action codes, got "
                          f"{array.dtype} {array.shape}")
-    array = array.astype(np.int64)
     bad = (array < 0) | (array >= codes.N_ACTIONS)
     if bad.any():
-        raise ValueError(f"action code {int(array[bad][0])} out of range [0, {codes.N_ACTIONS})")
-    return array
+        raise ValueError(f"action code {array[bad][0]} out of range [0, {codes.N_ACTIONS})")
+    return array.astype(np.int64)
 
 
 _INT_TYPES = (int, np.int8, np.int16, np.int32, np.int64, np.uint8, np.uint16, np.uint32,

@@ -208,6 +208,7 @@ def _cmd_match(args):
 
     if args.replay:
         check_output_path(args.replay, "replay")  # before the match, not after it
+    _check_policy_files((args.p1, args.p2))
     result, rep, timing = play_match(
         args.p1, args.p2, seed=args.seed, rounds=args.rounds, rules=_rules_from(args),
         limits=_limits_from(args), max_faults=args.max_faults, isolation=args.isolation,
@@ -223,10 +224,25 @@ def _cmd_match(args):
     return 0
 
 
+def _check_policy_files(specs):
+    """A policy file named on the command line that cannot be played is an error now (exit 2,
+    with the field at fault), not a forfeit after the match starts."""
+    from .bots import BotLoadError, is_policy_file
+    from .policy import Policy, PolicyError
+
+    for spec in specs:
+        if is_policy_file(spec):
+            try:
+                Policy.load(spec)
+            except PolicyError as exc:
+                raise BotLoadError(str(exc)) from None
+
+
 def _cmd_tournament(args):
     from .tournament import format_table, run_tournament
 
     bots = [b.strip() for b in args.bots.split(",") if b.strip()]
+    _check_policy_files(bots)
     report, stats = run_tournament(
         bots, games=args.games, seed=args.seed, rounds=args.rounds, rules=_rules_from(args),
         workers=args.workers, progress=not args.no_progress and not args.json,

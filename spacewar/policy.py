@@ -29,6 +29,8 @@ import io
 import json
 import math
 import os
+import re
+import stat
 import zipfile
 
 import numpy as np
@@ -122,39 +124,111 @@ def save_policy(path, weights, metadata):
 
 
 # -- loading and validation -----------------------------------------------------------------
-def _read_npz(source, where):
-    """Every array of an .npz, its header checked (dtype, size) before its data is read."""
+#: member names a policy archive may hold: the fixed fields and w0, b0 ... w15, b15
+_MEMBER = re.compile(r"(format|format_version|metadata|inputs|[wb](?:[0-9]|1[0-5]))\.npy")
+#: the exact (little-endian) types of the weights and biases; the other numbers are int64
+_FIELD_TYPES = {"w": np.dtype("<f4"), "b": np.dtype("<f4")}
+MAX_FILE_BYTES = 1 << 28  # a policy file is at most 256 MiB
+MAX_TOTAL_NUMBERS = 1 << 24  # all of a policy's arrays hold at most 16 Mi numbers (64 MiB)
+MAX_TEXT = 1 << 16  # characters of the format and metadata texts
+
+
+def read_policy_bytes(path, where):
+    """The bytes of the policy file at ``path``: a regular file (never a FIFO or device,
+    which could block or never end), opened without blocking, of at most ``MAX_FILE_BYTES``,
+    read from the descriptor that was checked."""
     try:
-        with zipfile.ZipFile(source) as archive:
-            for info in archive.infolist():
-                if not info.filename.endswith(".npy"):
-                    raise PolicyError(f"{where}: unexpected member {info.filename!r} in the archive")
-                with archive.open(info) as f:
-                    try:
-                        version = np.lib.format.read_magic(f)
-                        read_header = {(1, 0): np.lib.format.read_array_header_1_0,
-                                       (2, 0): np.lib.format.read_array_header_2_0}.get(version)
-                        if read_header is None:
-                            raise ValueError(f"unknown .npy format version {version}")
-                        shape, _, dtype = read_header(f)
-                    except ValueError as exc:
-                        raise PolicyError(f"{where}: field {info.filename[:-4]!r} is not a "
-                                          f"NumPy array: {exc}") from None
-                if dtype.hasobject:
-                    raise PolicyError(f"{where}: field {info.filename[:-4]!r} holds Python objects "
-                                      "(pickled data), which a policy never does")
-                if math.prod(shape) > MAX_ELEMENTS:
-                    raise PolicyError(f"{where}: field {info.filename[:-4]!r} has shape {shape}, "
-                                      f"over the {MAX_ELEMENTS} numbers a policy array may hold")
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+    except OSError as exc:
+        raise PolicyError(f"cannot read {where}: {exc.strerror or exc}") from None
+    try:
+        info = os.fstat(fd)
+        if not stat.S_ISREG(info.st_mode):
+            raise PolicyError(f"{where} is not a regular file")
+        if info.st_size > MAX_FILE_BYTES:
+            raise PolicyError(f"{where} has {info.st_size} bytes, over the {MAX_FILE_BYTES} a "
+                              "policy file may have")
+        chunks, left = [], MAX_FILE_BYTES + 1
+        while left > 0:
+            chunk = os.read(fd, min(left, 1 << 20))
+            if not chunk:
+                break
+            chunks.append(chunk)
+            left -= len(chunk)
+        if left <= 0:
+            raise PolicyError(f"{where} grew past the {MAX_FILE_BYTES} bytes a policy file may "
+                              "have while it was read")
+        return b"".join(chunks)
+    except OSError as exc:
+        raise PolicyError(f"cannot read {where}: {exc.strerror or exc}") from None
+    finally:
+        os.close(fd)
+
+
+def _read_npz(source, where):
+    """Every array of an .npz, all of its members' names, types and sizes checked from their
+    headers before any data is read; every failure is a ``PolicyError``."""
+    try:
+        return _read_checked_npz(source, where)
+    except PolicyError:
+        raise
+    except MemoryError:
+        raise PolicyError(f"{where} is too large to read") from None
     except zipfile.BadZipFile as exc:
         raise PolicyError(f"{where} is not an .npz archive: {exc}") from None
-    if hasattr(source, "seek"):
-        source.seek(0)
-    try:
-        with np.load(source, allow_pickle=False) as npz:
-            return {name: npz[name] for name in npz.files}
-    except (ValueError, OSError, EOFError, zipfile.BadZipFile) as exc:
-        raise PolicyError(f"{where} cannot be read as an .npz archive: {exc}") from None
+    except Exception as exc:  # zlib, bz2, lzma, zipfile: any archive that cannot be read
+        raise PolicyError(f"{where} cannot be read as an .npz archive: "
+                          f"{type(exc).__name__}: {exc}") from None
+
+
+def _read_checked_npz(source, where):
+    total = 0
+    with zipfile.ZipFile(source) as archive:
+        infos = archive.infolist()
+        names = [info.filename for info in infos]
+        for name in names:
+            if not _MEMBER.fullmatch(name):
+                raise PolicyError(f"{where}: unexpected member {name[:100]!r} in the archive")
+        if len(set(names)) != len(names):
+            raise PolicyError(f"{where}: a member appears twice in the archive")
+        for info in infos:
+            field = info.filename[:-4]
+            with archive.open(info) as f:
+                try:
+                    version = np.lib.format.read_magic(f)
+                    read_header = {(1, 0): np.lib.format.read_array_header_1_0,
+                                   (2, 0): np.lib.format.read_array_header_2_0}.get(version)
+                    if read_header is None:
+                        raise ValueError(f"unknown .npy format version {version}")
+                    shape, fortran, dtype = read_header(f)
+                    header_bytes = f.tell()
+                except ValueError as exc:
+                    raise PolicyError(f"{where}: field {field!r} is not a NumPy array: "
+                                      f"{exc}") from None
+            if dtype.hasobject:
+                raise PolicyError(f"{where}: field {field!r} holds Python objects (pickled "
+                                  "data), which a policy never does")
+            if field in ("format", "metadata"):
+                if dtype.kind != "U" or dtype.byteorder not in "<=|" \
+                        or dtype.itemsize > 4 * MAX_TEXT:
+                    raise PolicyError(f"{where}: field {field!r} must be a text of at most "
+                                      f"{MAX_TEXT} characters, got {dtype.str}")
+            elif dtype != _FIELD_TYPES.get(field[0], np.dtype("<i8")):
+                raise PolicyError(f"{where}: field {field!r} must be "
+                                  f"{_FIELD_TYPES.get(field[0], np.dtype('<i8')).name}, got "
+                                  f"{dtype.str}")
+            numbers = math.prod(shape)
+            total += numbers
+            if numbers > MAX_ELEMENTS or total > MAX_TOTAL_NUMBERS:
+                raise PolicyError(f"{where}: field {field!r} has shape {shape}, over the "
+                                  f"{MAX_TOTAL_NUMBERS} numbers a policy may hold in all")
+            if info.file_size != header_bytes + numbers * dtype.itemsize:
+                raise PolicyError(f"{where}: field {field!r} declares {info.file_size} bytes "
+                                  "where its header says otherwise")
+        if hasattr(source, "seek"):
+            source.seek(0)
+    with np.load(source, allow_pickle=False) as npz:
+        return {name: npz[name] for name in npz.files}
 
 
 def _field(arrays, name, where):
@@ -278,11 +352,7 @@ class Policy:
     def load(cls, path):
         """Read and validate a policy file (``np.load(..., allow_pickle=False)``)."""
         where = f"policy file {os.fspath(path)!r}"
-        try:
-            with open(path, "rb") as f:
-                data = f.read()
-        except OSError as exc:
-            raise PolicyError(f"cannot read {where}: {exc.strerror or exc}") from None
+        data = read_policy_bytes(path, where)
         return cls(*_parse(_read_npz(io.BytesIO(data), where), where))
 
     def logits(self, obs, seat=0):
@@ -296,10 +366,11 @@ class Policy:
         if seat == 1:  # trained in seat 0: seat 1's view turned half way (``seat_signs``)
             obs = obs * self._seat_signs
         h = obs[:, self.inputs].astype(np.float32, copy=False)
-        for i, (w, b) in enumerate(self.layers):
-            h = h @ w + b
-            if i < len(self.layers) - 1:
-                h = self._act(h)
+        with np.errstate(over="ignore", invalid="ignore"):  # huge weights: no warning flood
+            for i, (w, b) in enumerate(self.layers):
+                h = h @ w + b
+                if i < len(self.layers) - 1:
+                    h = self._act(h)
         return h
 
     def act_batch(self, obs, greedy=True, rng=None, seat=0):

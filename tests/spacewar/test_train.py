@@ -169,7 +169,7 @@ def _meta(good, **changes):
     (lambda g: {"b2": np.full(9, np.nan, np.float32)}, "'b2' holds non-finite"),
     (lambda g: {"w2": None}, "missing field 'w2'"),
     (lambda g: {"inputs": g["inputs"][::-1].copy()}, "'inputs' must be increasing"),
-    (lambda g: {"inputs": g["inputs"].astype(np.int32)}, "'inputs' must be a non-empty 1-d int64"),
+    (lambda g: {"inputs": g["inputs"].astype(np.int32)}, "'inputs' must be int64, got <i4"),
     (lambda g: {"format": np.array("something-else")}, "'format' must be"),
     (lambda g: {"format_version": np.array(99, np.int64)}, "'format_version' is 99"),
     (lambda g: {"metadata": np.array("{not json")}, "'metadata' is not valid JSON"),
@@ -180,7 +180,7 @@ def _meta(good, **changes):
     (lambda g: {"metadata": _meta(g, layout_sha256="0" * 64)}, "'layout_sha256'"),
     (lambda g: {"metadata": _meta(g, frame_skip=0)}, "'frame_skip'"),
     (lambda g: {"metadata": _meta(g, layers=2)}, "'w1' must have shape|unexpected fields"),
-    (lambda g: {"extra": np.zeros(3)}, "unexpected fields \\['extra'\\]"),
+    (lambda g: {"extra": np.zeros(3)}, "unexpected member 'extra.npy'"),
 ])
 def test_a_tampered_policy_file_is_refused_naming_the_field(tmp_path, good, change, message):
     path = _tampered(tmp_path, good, **change(good))
