@@ -140,6 +140,16 @@ class Observation:
         """The flat raw observation this one was made from (``raw_layout``), read-only."""
         return object.__getattribute__(self, "_raw")
 
+    def __getattr__(self, name):
+        # Reached only for a field not decoded yet: ``observation_from_raw`` decodes the
+        # ships, torpedoes and header from the raw numbers when one of them is first read,
+        # so a frame costs the match nothing for what its bot never looks at.
+        fields = object.__getattribute__(self, "__dict__")
+        if name in _DECODED and name not in fields and fields.get("_raw") is not None:
+            fields.update(_decode(fields["_raw"]))
+            return fields[name]
+        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+
     def vector(self):
         """A flat float64 vector of fixed length (see ``vector_layout``), for learning code."""
         if self._vector is None and self._raw is not None:  # made on first use only
@@ -222,39 +232,51 @@ def _ship_vector(x, scales):
 
 def observation_from_raw(raw, rules, shown_rules=None):
     """The ``Observation`` a raw array describes (arrays in it are read-only copies).
-    ``rules`` decode it; ``shown_rules`` (default ``rules``) is what ``obs.rules`` holds."""
+    ``rules`` decode it; ``shown_rules`` (default ``rules``) is what ``obs.rules`` holds. Its
+    fields are decoded from its own copy of the raw numbers when one is first read."""
     raw = np.asarray(raw, dtype=np.float64)
     if raw.shape != (raw_length(rules),):
         raise ValueError(f"raw observation must have shape ({raw_length(rules)},), got {raw.shape}")
     raw = _frozen(raw.copy())  # the bot's own copy: pos, vel and star_pos are views of it
+    return _made(Observation, {"rules": rules if shown_rules is None else shown_rules,
+                               "_vector": None, "_raw": raw, "_scales": _scales(rules)})
+
+
+#: the fields ``_decode`` makes (every field of an Observation but the rules)
+_DECODED = frozenset({"me", "enemy", "torpedoes", "star_pos", "star_mu", "star_capture",
+                      "frame", "round_frame", "round", "score", "seat"})
+
+
+def _decode(raw):
+    """The fields of the observation whose raw numbers are ``raw`` (read-only)."""
     h = raw[:_NH].tolist()
-    me = _ship_from_raw(raw[_NH:_NH + _NS])
-    enemy = _ship_from_raw(raw[_NH + _NS:_NH + 2 * _NS])
     first = _NH + 2 * _NS
     torpedoes = []
-    for k in np.flatnonzero(raw[first::_NT]).tolist():  # the live slots, in slot order
+    for k in np.nonzero(raw[first::_NT])[0].tolist():  # the live slots, in slot order
         a = first + k * _NT
         x = raw[a:a + _NT].tolist()
         torpedoes.append(_made(Torpedo, {"pos": raw[a + 1:a + 3], "vel": raw[a + 3:a + 5],
                                          "mine": bool(x[5]), "ttl": int(x[6]), "charge": x[7]}))
-    return _made(Observation, {
-        "me": me, "enemy": enemy, "torpedoes": tuple(torpedoes), "star_pos": raw[8:10],
-        "star_mu": h[6], "star_capture": h[7], "frame": int(h[0]), "round_frame": int(h[1]),
-        "round": int(h[2]), "score": (int(h[3]), int(h[4])), "seat": int(h[5]),
-        "rules": rules if shown_rules is None else shown_rules, "_vector": None, "_raw": raw,
-        "_scales": _scales(rules)})
+    return {"me": _ship_from_raw(raw[_NH:_NH + _NS]),
+            "enemy": _ship_from_raw(raw[_NH + _NS:first]), "torpedoes": tuple(torpedoes),
+            "star_pos": raw[8:10], "star_mu": h[6], "star_capture": h[7], "frame": int(h[0]),
+            "round_frame": int(h[1]), "round": int(h[2]), "score": (int(h[3]), int(h[4])),
+            "seat": int(h[5])}
 
 
 def _scales(rules):
-    """``_scale_numbers(rules)``, kept for the rules object last asked about (a match asks
-    with the same one every frame, and hashing the rules costs more than the numbers)."""
-    global _LAST_SCALES
-    if _LAST_SCALES[0] is not rules:
-        _LAST_SCALES = (rules, _scale_numbers(rules))
-    return _LAST_SCALES[1]
+    """``_scale_numbers(rules)``, kept for the last few rules objects asked about (each seat
+    of a match asks with its own every frame; hashing the rules costs more than the numbers,
+    so they are known by identity, the object kept alive with its numbers)."""
+    kept = _SCALES.get(id(rules))
+    if kept is None or kept[0] is not rules:
+        if len(_SCALES) >= 16:
+            _SCALES.clear()
+        kept = _SCALES[id(rules)] = (rules, _scale_numbers(rules))
+    return kept[1]
 
 
-_LAST_SCALES = (None, None)
+_SCALES = {}
 
 
 def _scale_numbers(rules):

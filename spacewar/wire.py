@@ -24,6 +24,8 @@ import struct
 
 import numpy as np
 
+from .protocol import _short_repr, action_code
+
 START_MAGIC, OBSERVE_MAGIC, STOP_MAGIC, ANSWER_MAGIC = b"SWS1", b"SWO1", b"SWQ1", b"SWA1"
 START_HEADER = struct.Struct("<4sI")
 OBSERVE_HEADER = struct.Struct("<4sqI")
@@ -94,10 +96,7 @@ def ask(bot, obs):
     match for a bot it calls directly (``spacewar.seats.InlineSeat``). The code comes from the
     answer's fields (``spacewar.protocol.action_code``), never from what its class says.
     """
-    from .batch_bots import SingleFromBatch
-    from .protocol import _short_repr, action_code
-
-    if isinstance(bot, SingleFromBatch):  # a batch bot playing one match: K = 1
+    if type(bot) is _single_from_batch():  # a batch bot playing one match: K = 1
         return bot.answer(obs)
     try:
         result = bot.act(obs)
@@ -111,6 +110,18 @@ def ask(bot, obs):
         return INVALID, 0, f"returned {_short_repr(result)}: {exc}"
     except BaseException as exc:
         return INVALID, 0, exception_text(exc)
+
+
+_SINGLE_FROM_BATCH = []
+
+
+def _single_from_batch():
+    """``batch_bots.SingleFromBatch``, imported on first use (that module imports this one)."""
+    if not _SINGLE_FROM_BATCH:
+        from .batch_bots import SingleFromBatch
+
+        _SINGLE_FROM_BATCH.append(SingleFromBatch)
+    return _SINGLE_FROM_BATCH[0]
 
 
 def pack_answer(frame, status, code=0, text=""):

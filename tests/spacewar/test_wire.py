@@ -104,3 +104,26 @@ def test_action_code_trusts_the_fields_not_the_class():
     assert action_code(Sly(thrust=True)) == 1 + 3
     for code in range(48):
         assert action_code(Action.from_code(code)) == code
+
+
+def test_an_observation_is_decoded_when_first_read_with_the_raw_numbers():
+    from spacewar import Game
+
+    game = Game(Rules(), seeds=[3], rounds=2)
+    for _ in range(300):
+        game.step([[7, 10]])
+    raw = game.raw_observation(0, 1)
+    obs = observation_from_raw(raw, game.rules)
+    assert "me" not in vars(obs)  # nothing decoded yet: the match paid only for the copy
+    names = raw_layout(game.rules)
+    value = dict(zip(names, raw.tolist()))
+    assert obs.seat == 1 and obs.frame == value["frame"] == 300
+    assert obs.me.pos.tolist() == [value["me.x"], value["me.y"]]
+    assert obs.enemy.fuel == value["enemy.fuel"]
+    live = [k for k in range(2 * game.rules.torpedoes) if value[f"torpedo{k}.present"]]
+    assert len(obs.torpedoes) == len(live) > 0
+    assert [t.ttl for t in obs.torpedoes] == [value[f"torpedo{k}.ttl"] for k in live]
+    raw[:] = 0.0  # the observation decoded its own copy
+    assert obs.torpedoes[0].pos.tolist() != [0.0, 0.0] and not obs.me.pos.flags.writeable
+    with pytest.raises(AttributeError, match="no attribute 'nothing'"):
+        obs.nothing
