@@ -65,7 +65,7 @@ except ImportError as error:  # pragma: no cover - the extra is missing
 
 from . import core
 from .codes import codes_from_parts
-from .learning import LearningBatch, learning_layout, learning_length, seat_kinds
+from .learning import LearningBatch, copy_rows, learning_layout, learning_length, seat_kinds
 from .learning import compiled_bots
 from .batch_bots import checked_codes
 from .protocol import action_code
@@ -243,7 +243,11 @@ class SpacewarVectorEnv(VectorEnv):
         return self._out(self._view(self._batch.observations)), {}
 
     def _out(self, array):
-        return array.copy() if self.copy else array
+        if not self.copy:
+            return array
+        out = np.empty(array.shape, dtype=array.dtype)
+        copy_rows(array, out)
+        return out
 
     def _match_mask(self, mask):
         mask = np.asarray(mask)

@@ -418,6 +418,16 @@ class LearningBatch:
         return self._codes
 
 
+@jit(parallel=True)
+def copy_rows(source, out):
+    """``out[:] = source`` for (K, D) float32 rows, the rows spread over the threads (the
+    vector env's fresh observations each step: a copy of megabytes that one thread would
+    take a quarter of the step on)."""
+    for k in prange(source.shape[0]):
+        for j in range(source.shape[1]):
+            out[k, j] = source[k, j]
+
+
 def seat_kinds(opponents):
     """(2,) int64: each seat's compiled bot kind, ``EXTERNAL`` for None."""
     if not isinstance(opponents, (tuple, list)) or len(opponents) != 2:
@@ -473,5 +483,5 @@ def learning_vector(raw, rules, rounds):
 
 __all__ = ["learning_layout", "learning_length", "learning_scales", "learning_vector",
            "write_learning", "write_all_learning", "episode_stream", "step_learning",
-           "LearningBatch", "seat_kinds", "AUTORESET_MODES", "NEXT_STEP", "SAME_STEP", "DISABLED",
+           "LearningBatch", "seat_kinds", "copy_rows", "AUTORESET_MODES", "NEXT_STEP", "SAME_STEP", "DISABLED",
            "EXTERNAL"]
