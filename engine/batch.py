@@ -83,6 +83,17 @@ def advance_system_in(m, t, h, steps, state, model, work, vdep, drifts, kicks, s
                                 work, vdep, np.nan, drifts, kicks, scratch)
 
 
+@njit(cache=True, error_model="numpy", _nrt=False, inline="always")
+def advance_system_general_in(m, t, h, steps, state, model, work, vdep, drifts, kicks, scratch):
+    """``advance_system_in`` by the general executor alone (``splitting.advance_general_in``):
+    for a compiled caller built without reference counting (``_nrt=False``), whose systems'
+    terms are not gravity alone (the only ones the fused executor takes, with the same
+    bits). Nothing is allocated."""
+    return splitting.advance_general_in(t, h, steps, system_state(state, m),
+                                        system_model(model, m), work, vdep, drifts, kicks,
+                                        scratch)
+
+
 @njit(cache=True, error_model="numpy")
 def step_system(m, family, t, h, steps, state, model, work, vdep, tol, drifts, kicks):
     """System m advanced by the integrator ``family`` (SPLITTING with its coefficients,
@@ -593,5 +604,5 @@ def _family(name):
     return {"euler": EULER, "rk4": RK4, "rk45": RK45}[name], empty, empty
 
 
-__all__ = ["Batch", "advance_system", "advance_system_in", "step_system", "system_state", "system_model",
+__all__ = ["Batch", "advance_system", "advance_system_in", "advance_system_general_in", "step_system", "system_state", "system_model",
            "SPLITTING", "EULER", "RK4", "RK45"]

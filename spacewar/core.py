@@ -18,7 +18,7 @@ import math
 import numpy as np
 
 from engine import space
-from engine.batch import advance_system_in
+from engine.batch import advance_system_general_in
 from engine.cache import compiler
 from engine.integrators import splitting
 from engine.state import Model, State, Workspace
@@ -325,7 +325,7 @@ def _round_logic(m, pos, vel, mass, charge, active, ship_gauges, ship_counters, 
     reset_round(m, pos, vel, mass, charge, active, ship_gauges, ship_counters, torp_life, match_state, rules)
 
 
-@jit()
+@jit(_nrt=False)
 def step_match(m, actions, state, model, work, ship_gauges, ship_counters, torp_life,
                match_state, rng, rules, drifts, kicks, marks, scratch):
     """Advance match ``m`` by one frame with ``actions[m, 0]`` and ``actions[m, 1]``.
@@ -346,8 +346,8 @@ def step_match(m, actions, state, model, work, ship_gauges, ship_counters, torp_
                  ship_gauges, ship_counters, torp_life, force_params, rng, rules)
     # motion: the engine's symplectic Euler kernel on this match's system, dt = 1 frame, with
     # the engine's forces; its drift wraps positions onto the torus (the batch's box = 1)
-    _, _, _, status = advance_system_in(m, 0.0, 1.0, 1, state, model, work, False, drifts, kicks,
-                                        scratch)
+    _, _, _, status = advance_system_general_in(m, 0.0, 1.0, 1, state, model, work, False,
+                                                drifts, kicks, scratch)
     if status >= 0:
         match_state[m, ERROR] = 1
         match_state[m, OVER] = 1

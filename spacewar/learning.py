@@ -110,7 +110,7 @@ def _write_gauges(out, o, m, s, ship_gauges, ship_counters, scales):
     out[o + 7] = ship_counters[m, s, core.IN_HYPER]
 
 
-@jit()
+@jit(_nrt=False)  # no reference counting: it allocates nothing (see core's note)
 def write_learning(m, seat, pos, vel, charge, active, ship_gauges, ship_counters, torp_life,
                    match_state, rules, scales, out):
     """Match ``m`` seen from ``seat`` as a learning observation, into ``out`` (float32, D)."""

@@ -91,14 +91,16 @@ def advance_in(t, h, steps, state, model, work, vdep, t_end, drifts, kicks, scra
         f0 = model.param_offsets[0]
         return fused_gravity.advance(t, h, steps, state.pos, state.vel, state.mass, state.active,
                                      state.n, model.params[f0], model.params[f0 + 1], drifts, kicks)
-    return _advance_general_in(t, h, steps, state, model, work, vdep, drifts, kicks, scratch)
+    return advance_general_in(t, h, steps, state, model, work, vdep, drifts, kicks, scratch)
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def _advance_general_in(t, h, steps, state, model, work, vdep, drifts, kicks, scratch):
-    """The general executor as a call compiled without reference counting (``_nrt=False``,
-    as the force kernels are: it allocates nothing), so that a caller stepping system after
-    system does not pay two atomic updates per array of the state and model on each call."""
+def advance_general_in(t, h, steps, state, model, work, vdep, drifts, kicks, scratch):
+    """``advance_in`` without the fused path (the general executor, every term through the
+    dispatch table: the same bits for every scene), compiled without reference counting
+    (``_nrt=False``, as the force kernels are: it allocates nothing), so that a caller
+    stepping system after system pays no atomic updates per array on each call, and a
+    caller compiled the same way may call it."""
     return _advance_general(t, h, steps, state, model, work, vdep, drifts, kicks, scratch)
 
 
