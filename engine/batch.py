@@ -75,20 +75,12 @@ def advance_system(m, t, h, steps, state, model, work, vdep, drifts, kicks):
                              vdep, np.nan, drifts, kicks)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
-def advance_system_in(m, t, h, steps, state, model, work, vdep, drifts, kicks, scratch):
-    """``advance_system`` in caller-owned scratch (``splitting.scratch_rows(dim)`` rows by
-    ``n``, reused from system to system): nothing is allocated per call. Same bits."""
-    return splitting.advance_in(t, h, steps, system_state(state, m), system_model(model, m),
-                                work, vdep, np.nan, drifts, kicks, scratch)
-
-
 @njit(cache=True, error_model="numpy", _nrt=False, inline="always")
 def advance_system_general_in(m, t, h, steps, state, model, work, vdep, drifts, kicks, scratch):
-    """``advance_system_in`` by the general executor alone (``splitting.advance_general_in``):
-    for a compiled caller built without reference counting (``_nrt=False``), whose systems'
-    terms are not gravity alone (the only ones the fused executor takes, with the same
-    bits). Nothing is allocated."""
+    """``advance_system`` by the general executor alone (``splitting.advance_general_in``), in
+    caller-owned scratch (``splitting.scratch_rows(dim)`` rows by ``n``, reused from system to
+    system): nothing is allocated, and a caller compiled without reference counting
+    (``_nrt=False``) may call it. Same bits as ``advance_system``."""
     return splitting.advance_general_in(t, h, steps, system_state(state, m),
                                         system_model(model, m), work, vdep, drifts, kicks,
                                         scratch)
@@ -604,5 +596,5 @@ def _family(name):
     return {"euler": EULER, "rk4": RK4, "rk45": RK45}[name], empty, empty
 
 
-__all__ = ["Batch", "advance_system", "advance_system_in", "advance_system_general_in", "step_system", "system_state", "system_model",
+__all__ = ["Batch", "advance_system", "advance_system_general_in", "step_system", "system_state", "system_model",
            "SPLITTING", "EULER", "RK4", "RK45"]

@@ -76,6 +76,14 @@ _INT_TYPES = (int, np.int8, np.int16, np.int32, np.int64, np.uint8, np.uint16, n
               np.uint64)
 
 
+def one_match_bot(bot, rules, rounds):
+    """``bot`` as a match alone asks it: a batch bot without ``act`` wrapped in
+    ``SingleFromBatch`` (K = 1), any other bot as it is."""
+    if is_batch_bot(bot) and not callable(getattr(bot, "act", None)):
+        return SingleFromBatch(bot, rules, rounds)
+    return bot
+
+
 class SingleFromBatch:
     """A batch bot playing one match: ``act(obs)`` asks ``act_batch`` with K = 1 on the
     learning observation of the ``Observation`` it gets (``spacewar.learning.learning_vector``
@@ -111,4 +119,4 @@ class SingleFromBatch:
         return Action.from_code(code)
 
 
-__all__ = ["is_batch_bot", "ask_batch", "checked_codes", "SingleFromBatch"]
+__all__ = ["is_batch_bot", "ask_batch", "checked_codes", "one_match_bot", "SingleFromBatch"]

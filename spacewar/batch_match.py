@@ -27,11 +27,12 @@ from . import core
 from .batch_bots import ask_batch, is_batch_bot
 from .bots import is_builtin, is_policy_file
 from .game import Game
+from .learning import learning_length
 from .match import (DEFAULT_BUDGET, DEFAULT_MAX_FAULTS, FaultLog, _cpu_seconds, _result,
-                    bot_seed)
+                    bot_seed, checked_limits)
 from .protocol import raw_length
-from .rules import Rules
-from .seats import _KIND_BY_STATUS, Limits, bot_name, open_seat
+from .rules import Rules, count_at_least
+from .seats import _KIND_BY_STATUS, _Bank, bot_name, open_seat
 from .wire import INVALID, OK, exception_text
 
 
@@ -83,35 +84,33 @@ def play_matches(matches, rounds=5, rules=None, budget=DEFAULT_BUDGET,
             if not can_play_together(spec):
                 raise ValueError(f"play_matches plays batch bots, policy files and built-in "
                                  f"bots; {bot_name(spec)!r} plays with play_match")
-        if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-            raise ValueError(f"seed must be an int >= 0, got {seed!r}")
-    if isinstance(max_faults, bool) or not isinstance(max_faults, int) or max_faults < 1:
-        raise ValueError(f"max_faults must be an int >= 1, got {max_faults!r}")
-    limits = Limits(budget=budget) if limits is None else limits
-    if not isinstance(limits, Limits):
-        raise TypeError(f"limits must be a spacewar.seats.Limits, got {limits!r}")
+        count_at_least("seed", seed, 0)
+    limits = checked_limits(max_faults, budget, limits)
     count = len(matches)
     game = Game(rules, seeds=[seed for _, _, seed in matches], rounds=rounds)
     faults = [[FaultLog(), FaultLog()] for _ in range(count)]
-    forfeits = [[False, False] for _ in range(count)]
-    banks = [[_share_bank(limits), _share_bank(limits)] for _ in range(count)]
+    forfeits = np.zeros((count, 2), dtype=bool)
+    banks = [[_Bank(limits), _Bank(limits)] for _ in range(count)]
     sides, seats = _open(matches, limits, rules, rounds)
     for side in sides:
         if side.dead is not None:
             for m, s in side.rows:
                 faults[m][s].add(0, *side.dead)
-                forfeits[m][s] = True
+                forfeits[m, s] = True
     for m, row in enumerate(seats):
         for s, seat in enumerate(row):
             if seat is not None and seat.wait_ready() is not None:
                 faults[m][s].add(0, *seat.dead)
-                forfeits[m][s] = True
+                forfeits[m, s] = True
     match_state = game.match_state
+    # a match whose seat forfeits stops where it is, as a match alone stops: over, so that
+    # the game steps it no more and the loop below asks nothing of it
+    match_state[forfeits.any(axis=1), core.OVER] = 1
     actions = np.full((count, 2), core.NOOP, dtype=np.int64)
     raw = np.empty(raw_length(rules))
-    learning = np.zeros((count, 2, _learning_length(rules)), dtype=np.float32) if sides else None
+    learning = np.zeros((count, 2, learning_length(rules)), dtype=np.float32) if sides else None
     start = time.perf_counter()
-    live = _live(match_state, forfeits)
+    live = match_state[:, core.OVER] == 0
     while live.any():
         if learning is not None:
             game.learning_observations(learning)
@@ -128,11 +127,11 @@ def play_matches(matches, rounds=5, rules=None, budget=DEFAULT_BUDGET,
         for m in np.flatnonzero(live):
             for s in range(2):
                 if faults[m][s].total >= max_faults:
-                    forfeits[m][s] = True
-            if any(forfeits[m]):
-                match_state[m, core.OVER] = 1  # stops where it is, as a match alone stops
+                    forfeits[m, s] = True
+            if forfeits[m].any():
+                match_state[m, core.OVER] = 1
         game._step_codes(actions)  # codes from the checks above: valid
-        live = _live(match_state, forfeits)
+        live = match_state[:, core.OVER] == 0
     wall = time.perf_counter() - start
     outputs = [[None, None] for _ in range(count)]
     for m, row in enumerate(seats):
@@ -142,26 +141,10 @@ def play_matches(matches, rounds=5, rules=None, budget=DEFAULT_BUDGET,
     out = []
     for m, (p1, p2, seed) in enumerate(matches):
         result = _result(game, (bot_name(p1), bot_name(p2)), seed, rounds, rules, faults[m],
-                         forfeits[m], outputs[m], m=m)
+                         forfeits[m].tolist(), outputs[m], m=m)
         out.append((result, {"wall_seconds": wall / count,
                              "frames_per_second": result["steps"] / max(wall / count, 1e-9)}))
     return out
-
-
-def _learning_length(rules):
-    from .learning import learning_length
-
-    return learning_length(rules)
-
-
-def _share_bank(limits):
-    from .seats import _Bank
-
-    return _Bank(limits)
-
-
-def _live(match_state, forfeits):
-    return (match_state[:, core.OVER] == 0) & ~np.array([any(f) for f in forfeits])
 
 
 def _open(matches, limits, rules, rounds):

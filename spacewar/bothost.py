@@ -67,12 +67,10 @@ def _load(config):
 
     if config.get("path"):
         sys.path.insert(0, config["path"])
-    from .batch_bots import SingleFromBatch, is_batch_bot
+    from .batch_bots import one_match_bot
 
     rules = Rules.from_dict(config["rules"])
-    bot = make_bot(config["spec"], seed=config["seed"])
-    if is_batch_bot(bot) and not callable(getattr(bot, "act", None)):
-        bot = SingleFromBatch(bot, rules, config["rounds"])  # one match here: K = 1
+    bot = one_match_bot(make_bot(config["spec"], seed=config["seed"]), rules, config["rounds"])
     reset = getattr(bot, "reset", None)
     if callable(reset):
         reset()

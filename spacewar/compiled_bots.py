@@ -249,6 +249,12 @@ def star_accel(x, y, mu, capture):
     return (-mu * x) / den, (-mu * y) / den
 
 
+@jit(inline="always")
+def ship_motion(m, s, pos, vel):
+    """Ship s's position and velocity in match m, as four floats."""
+    return pos[m, 0, s], pos[m, 1, s], vel[m, 0, s], vel[m, 1, s]
+
+
 @jit(inline="always", **NUMERIC)
 def periapsis_r(x, y, r, vx, vy, mu):
     """``geometry.periapsis`` with ``r = |p|`` given (``mu > 0``, ``r > 0``): ``h = x v_y - y v_x``,
@@ -482,10 +488,7 @@ def chaser(m, seat, pos, vel, ship_gauges, ship_counters, rules, memory):
     en = 1 - seat
     if ship_counters[m, me, core.ALIVE] == 0 or ship_counters[m, me, core.IN_HYPER] == 1:
         return core.NOOP
-    x = pos[m, 0, me]
-    y = pos[m, 1, me]
-    vx = vel[m, 0, me]
-    vy = vel[m, 1, me]
+    x, y, vx, vy = ship_motion(m, me, pos, vel)
     heading = ship_gauges[m, me, core.HEADING]
     omega = ship_gauges[m, me, core.OMEGA]
     mu = rules[core.R_STAR]
@@ -896,10 +899,7 @@ def solve(m, seat, pos, vel, rules, memory, n, scratch):
     """``Sniper.solve``: the lead against the enemy path; where torpedoes feel the star the aim
     point is shifted twice by a Kepler torpedo's miss at the meeting frame. (t, heading)."""
     me = seat
-    x = pos[m, 0, me]
-    y = pos[m, 1, me]
-    vx = vel[m, 0, me]
-    vy = vel[m, 1, me]
+    x, y, vx, vy = ship_motion(m, me, pos, vel)
     mu = rules[core.R_STAR]
     t, h = lead_intercept(m, seat, pos, vel, rules, memory, n, scratch, 0.0, 0.0)
     if t == _NO_TIME or not (rules[core.R_TORP_STAR] != 0.0 and mu > 0.0):
@@ -995,10 +995,7 @@ def sniper_decide(m, seat, pos, vel, active, ship_gauges, ship_counters, torp_li
     lines up), wait while the enemy is unseen, else engage (navigate or aim, and fire)."""
     me = seat
     en = 1 - seat
-    x = pos[m, 0, me]
-    y = pos[m, 1, me]
-    vx = vel[m, 0, me]
-    vy = vel[m, 1, me]
+    x, y, vx, vy = ship_motion(m, me, pos, vel)
     heading = ship_gauges[m, me, core.HEADING]
     omega = ship_gauges[m, me, core.OMEGA]
     mu = rules[core.R_STAR]
@@ -1057,10 +1054,7 @@ def threat(m, seat, pos, vel, active, torp_life, rules, n_life, scratch):
     me = seat
     en = 1 - seat
     ntorp = torp_life.shape[1] // 2
-    x = pos[m, 0, me]
-    y = pos[m, 1, me]
-    vx = vel[m, 0, me]
-    vy = vel[m, 1, me]
+    x, y, vx, vy = ship_motion(m, me, pos, vel)
     mu = rules[core.R_STAR]
     gx, gy = star_accel(x, y, mu, rules[core.R_CAPTURE])
     g = math.hypot(gx, gy)  # np.hypot: the C library's

@@ -69,7 +69,7 @@ from .learning import LearningBatch, copy_rows, learning_layout, learning_length
 from .learning import compiled_bots
 from .batch_bots import checked_codes
 from .protocol import action_code
-from .rules import Rules
+from .rules import Rules, count_at_least
 
 ACTION_TYPES = ("multi_discrete", "discrete")
 NVEC = (3, 2, 2, 2)
@@ -173,9 +173,7 @@ class SpacewarVectorEnv(VectorEnv):
     def __init__(self, num_envs=1, opponent="random", rules=None, rounds=3, max_frames=20000,
                  render_mode=None, autoreset_mode="next_step", action_type="multi_discrete",
                  copy=True):
-        if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)) \
-                or num_envs < 1:
-            raise ValueError(f"num_envs must be an int >= 1, got {num_envs!r}")
+        count_at_least("num_envs", num_envs, 1)
         if render_mode is not None:
             raise ValueError(f"render_mode must be None for the vector env (SpacewarEnv renders), "
                              f"got {render_mode!r}")
@@ -185,11 +183,8 @@ class SpacewarVectorEnv(VectorEnv):
         self.metadata = {**type(self).metadata, "autoreset_mode": _AUTORESET[self.autoreset]}
         self.render_mode = None
         self.rules = Rules() if rules is None else rules
-        for name, value, low in (("rounds", rounds, 1), ("max_frames", max_frames, 0)):
-            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < low:
-                raise ValueError(f"{name} must be an int >= {low}, got {value!r}")
-        self.rounds = int(rounds)
-        self.max_frames = int(max_frames)
+        self.rounds = count_at_least("rounds", rounds, 1)
+        self.max_frames = count_at_least("max_frames", max_frames, 0)
         self.self_play = opponent is None
         if self.self_play and num_envs % 2:
             raise ValueError(f"self-play (opponent=None) needs an even num_envs (two seats a "
@@ -210,10 +205,9 @@ class SpacewarVectorEnv(VectorEnv):
 
     def _new_batch(self, seed):
         seed = int(np.random.SeedSequence(seed).entropy if seed is None else seed)
-        compiled = self._opponent.compiled
         self._batch = LearningBatch(self.matches, self.rules, seed=seed, rounds=self.rounds,
                                     frame_cap=self.max_frames, autoreset=self.autoreset,
-                                    opponents=(None, compiled if not self.self_play else None))
+                                    opponents=(None, self._opponent.compiled))
 
     def _view(self, array):
         """(M, 2, ...) per seat as the agent axis: seat 0 of each match, or both seats."""

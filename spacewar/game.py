@@ -18,7 +18,7 @@ from engine import Batch, forces
 
 from . import core
 from .protocol import Action, observation_from_raw, raw_length
-from .rules import Rules
+from .rules import Rules, count_at_least
 
 
 def force_terms(rules):
@@ -80,9 +80,8 @@ def _rules_vector(rules, rounds, thrust_offset):
 
 def seed_state(seed):
     """A 64-bit stream state from any non-negative int seed (via numpy's SeedSequence)."""
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise ValueError(f"seed must be an int >= 0, got {seed!r}")
-    return np.random.SeedSequence(int(seed)).generate_state(1, np.uint64)[0]
+    seed = count_at_least("seed", seed, 0)
+    return np.random.SeedSequence(seed).generate_state(1, np.uint64)[0]
 
 
 class Game:
@@ -92,8 +91,7 @@ class Game:
         rules = Rules() if rules is None else rules
         if not isinstance(rules, Rules):
             raise TypeError(f"rules must be a spacewar.Rules, got {rules!r}")
-        if isinstance(rounds, bool) or not isinstance(rounds, (int, np.integer)) or rounds < 1:
-            raise ValueError(f"rounds must be an int >= 1, got {rounds!r}")
+        count_at_least("rounds", rounds, 1)
         seeds = list(seeds)
         if not seeds:
             raise ValueError("seeds must hold at least one seed (one per match)")

@@ -30,7 +30,7 @@ from engine.state import Model, State, Workspace
 
 from . import compiled_bots, core
 from .protocol import raw_layout
-from .rules import Rules
+from .rules import Rules, count_at_least
 
 jit = core.jit
 
@@ -333,9 +333,7 @@ class LearningBatch:
                  autoreset="next_step", opponents=(None, None)):
         from .game import Game, seed_state
 
-        if isinstance(frame_cap, bool) or not isinstance(frame_cap, (int, np.integer)) \
-                or frame_cap < 0:
-            raise ValueError(f"frame_cap must be an int >= 0, got {frame_cap!r}")
+        count_at_least("frame_cap", frame_cap, 0)
         if autoreset not in AUTORESET_MODES:
             raise ValueError(f"autoreset must be one of {', '.join(AUTORESET_MODES)}, "
                              f"got {autoreset!r}")

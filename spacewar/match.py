@@ -18,7 +18,7 @@ import numpy as np
 from . import core
 from .game import Game
 from .protocol import raw_length
-from .rules import Rules
+from .rules import Rules, count_at_least
 from .seats import FAULT_KINDS, Limits, bot_name, open_seat, printable
 
 DEFAULT_BUDGET = 0.05  # seconds per action
@@ -67,13 +67,8 @@ def play_match(p1, p2, seed=0, rounds=5, rules=None, budget=DEFAULT_BUDGET,
     forfeits; the other bot wins (if both forfeit, nobody does).
     """
     rules = Rules() if rules is None else rules
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise ValueError(f"seed must be an int >= 0, got {seed!r}")
-    if isinstance(max_faults, bool) or not isinstance(max_faults, int) or max_faults < 1:
-        raise ValueError(f"max_faults must be an int >= 1, got {max_faults!r}")
-    limits = Limits(budget=budget) if limits is None else limits
-    if not isinstance(limits, Limits):
-        raise TypeError(f"limits must be a spacewar.seats.Limits, got {limits!r}")
+    count_at_least("seed", seed, 0)
+    limits = checked_limits(max_faults, budget, limits)
     game = Game(rules, seeds=[seed], rounds=rounds)
     cpu = _cpu_seconds(rules, rounds, limits)
     seats = []
@@ -126,6 +121,17 @@ def play_match(p1, p2, seed=0, rounds=5, rules=None, budget=DEFAULT_BUDGET,
         return result, make_replay(result, bytes(history), game.state_hash(0),
                                    faults=bytes(fault_codes), max_faults=max_faults), result_timing
     return result, None, result_timing
+
+
+def checked_limits(max_faults, budget, limits):
+    """The ``Limits`` a match plays under (``budget`` alone when ``limits`` is None), after
+    checking them and ``max_faults``."""
+    if isinstance(max_faults, bool) or not isinstance(max_faults, int) or max_faults < 1:
+        raise ValueError(f"max_faults must be an int >= 1, got {max_faults!r}")
+    limits = Limits(budget=budget) if limits is None else limits
+    if not isinstance(limits, Limits):
+        raise TypeError(f"limits must be a spacewar.seats.Limits, got {limits!r}")
+    return limits
 
 
 def _cpu_seconds(rules, rounds, limits):

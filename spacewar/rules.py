@@ -30,6 +30,14 @@ MODES = ("classic", "newtonian", "electric")
 STARS = ("heavy", "light", "none")
 
 
+def count_at_least(name, value, minimum):
+    """``value`` as an int if it is one (not a bool) of at least ``minimum``, else a
+    ValueError naming the field and the value (seeds, rounds, frame caps, env counts)."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < minimum:
+        raise ValueError(f"{name} must be an int >= {minimum}, got {value!r}")
+    return int(value)
+
+
 @dataclass(frozen=True)
 class Rules:
     """Every number the game uses. Frozen: make variants with ``rules.replace(...)``."""

@@ -35,7 +35,7 @@ import tempfile
 import time
 
 from . import codes, confinement, wire
-from .batch_bots import SingleFromBatch, is_batch_bot
+from .batch_bots import is_batch_bot, one_match_bot
 from .bots import BotLoadError, absolute_spec, is_builtin, locate, make_bot
 from .protocol import observation_from_raw
 
@@ -137,9 +137,8 @@ class InlineSeat:
         except BotLoadError as exc:  # a policy file that is not a valid policy
             self.bot, self.dead = None, ("startup", str(exc))
             return
-        if is_batch_bot(self.bot) and not callable(getattr(self.bot, "act", None)):
-            self.bot = SingleFromBatch(self.bot, self._rules, DEFAULT_ROUNDS if rounds is None
-                                       else rounds)
+        self.bot = one_match_bot(self.bot, self._rules,
+                                 DEFAULT_ROUNDS if rounds is None else rounds)
         try:
             reset = getattr(self.bot, "reset", None)
             if callable(reset):

@@ -66,7 +66,7 @@ def force_evaluations(name):
 
 @njit(cache=True, inline="always")
 def scratch_rows(dim):
-    """Rows of the scratch ``advance_in`` needs for a system of dimension ``dim``: the
+    """Rows of the scratch ``advance_general_in`` needs for a system of dimension ``dim``: the
     accelerations, the saved positions and velocities (dim rows each) and the motion mask."""
     return 3 * dim + 1
 
@@ -82,25 +82,14 @@ def advance(t, h, steps, state, model, work, vdep, t_end, drifts, kicks):
     return _advance_general(t, h, steps, state, model, work, vdep, drifts, kicks, scratch)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
-def advance_in(t, h, steps, state, model, work, vdep, t_end, drifts, kicks, scratch):
-    """``advance`` in caller-owned ``scratch`` of at least ``scratch_rows(dim)`` rows and
-    ``n`` columns, so that a compiled caller stepping many small systems (the game's
-    matches) allocates nothing per system. Same operations, same bits."""
-    if fused_gravity.applies(state, model):
-        f0 = model.param_offsets[0]
-        return fused_gravity.advance(t, h, steps, state.pos, state.vel, state.mass, state.active,
-                                     state.n, model.params[f0], model.params[f0 + 1], drifts, kicks)
-    return advance_general_in(t, h, steps, state, model, work, vdep, drifts, kicks, scratch)
-
-
 @njit(cache=True, error_model="numpy", _nrt=False)
 def advance_general_in(t, h, steps, state, model, work, vdep, drifts, kicks, scratch):
-    """``advance_in`` without the fused path (the general executor, every term through the
-    dispatch table: the same bits for every scene), compiled without reference counting
-    (``_nrt=False``, as the force kernels are: it allocates nothing), so that a caller
-    stepping system after system pays no atomic updates per array on each call, and a
-    caller compiled the same way may call it."""
+    """``advance`` by the general executor alone (every term through the dispatch table; the
+    fused path gives the same bits for the scenes it takes), in caller-owned ``scratch`` of
+    at least ``scratch_rows(dim)`` rows and ``n`` columns, compiled without reference
+    counting (``_nrt=False``, as the force kernels are: it allocates nothing): a compiled
+    caller stepping many small systems (the game's matches) allocates nothing per system and
+    pays no atomic updates per array on each call."""
     return _advance_general(t, h, steps, state, model, work, vdep, drifts, kicks, scratch)
 
 
