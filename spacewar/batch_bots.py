@@ -20,6 +20,7 @@ A NumPy or PyTorch policy so plays hundreds of matches in one forward pass.
 import numpy as np
 
 from . import codes
+from . import wire
 from .wire import INVALID, MEMORY, OK, RAISED, exception_text
 
 
@@ -118,5 +119,7 @@ class SingleFromBatch:
             raise ValueError(f"act_batch failed: {text}")
         return Action.from_code(code)
 
+
+wire._SINGLE_FROM_BATCH[0] = SingleFromBatch  # what wire.ask answers for with bot.answer
 
 __all__ = ["is_batch_bot", "ask_batch", "checked_codes", "one_match_bot", "SingleFromBatch"]

@@ -1209,7 +1209,7 @@ def dodge(m, seat, pos, vel, charge, active, ship_gauges, ship_counters, torp_li
 
 
 # -- the entry points -----------------------------------------------------------------------------
-@jit(_nrt=False, **NUMERIC)  # allocates nothing: no reference counting (see core's note)
+@jit(_nrt=False, inline="always", **NUMERIC)  # allocates nothing; inlined (core's note)
 def decide_with(kind, m, seat, pos, vel, charge, active, ship_gauges, ship_counters, torp_life,
                 match_state, rules, memory, bot_rng, scratch):
     """:func:`decide` with the sniper's and dodger's scratch given (``new_scratch``)."""

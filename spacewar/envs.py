@@ -200,7 +200,7 @@ class SpacewarVectorEnv(VectorEnv):
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
         self._batch = None
         # as Gymnasium's SyncVectorEnv(copy=...): False returns views of the batch's own
-        # buffers, which the next step overwrites (no copy of 4096 x 419 floats per step)
+        # buffers, which the next step overwrites (no copy of 4096 x 107 floats per step)
         self.copy = bool(copy)
 
     def _new_batch(self, seed):

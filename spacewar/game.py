@@ -123,7 +123,6 @@ class Game:
         self.match_state = np.zeros((m, core.MI), dtype=np.int64)
         self.rng = np.array([seed_state(s) for s in seeds], dtype=np.uint64)
         self._actions = np.full((m, 2), core.NOOP, dtype=np.int64)
-        self._doomed = np.zeros((m, 2, nb), dtype=np.int64)  # the collisions' scratch
         core.reset_all(self.pos, self.vel, self.mass, self.charge, self.active, self.ship_gauges,
                        self.ship_counters, self.torp_life, self.match_state, self.rules_vector)
         self._frame_arguments = self._gather_frame_arguments()
@@ -144,8 +143,7 @@ class Game:
         """What the compiled frame takes after the actions, gathered once (and again after a
         re-pack), not per frame."""
         return (*self.state, *self.model, self.ship_gauges, self.ship_counters, self.torp_life,
-                self.match_state, self.rng, self.rules_vector, self.drifts, self.kicks,
-                self._doomed)
+                self.match_state, self.rng, self.rules_vector, self.drifts, self.kicks)
 
     # the engine's arrays of every match: (M, 2, bodies) positions and velocities, (M, bodies)
     # masses, charges and active flags (the batch's storage, which the compiled frame writes)
@@ -174,6 +172,12 @@ class Game:
         loop's, which come from ``protocol.action_code``): no conversion, no checks."""
         self._sync_with_batch()
         core.step_all(codes, *self._frame_arguments)
+
+    def _step_one_codes(self, m, codes, raws):
+        """``_step_codes`` for match m alone, which also writes what each seat sees next into
+        ``raws`` (2, ``raw_length``): the match loop's one compiled call per frame."""
+        self._sync_with_batch()
+        core.step_one_and_observe(codes, *self._frame_arguments, m, raws)
 
     def _write_raw(self, m, seat, out):
         """``raw_observation(m, seat, out)`` for a caller that owns a right ``out``."""

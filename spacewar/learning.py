@@ -16,8 +16,13 @@ rotated into the ship's heading; the heading is given as its cosine and sine). S
 - the rest as fractions of their rules' maxima (fuel, torpedoes, jumps, reload and recharge
   frames, flip cool-down, torpedo life, round frames), flags as 0 or 1, the charge as its sign.
 
-The torpedo slots are fixed: the own ship's ``T`` first, then the enemy's ``T``, in firing order
-within a round, each with a presence flag; an empty slot is all zeros.
+The torpedo slots are fixed, each with a presence flag (an empty slot is all zeros): the own
+ship's ``S`` first, then the enemy's ``S``. ``S = torpedo_slots(rules)`` is the most torpedoes
+one ship can have in flight at once, not the ``T`` it carries (6 of 32 under the 1962 rules), and
+a ship's k-th torpedo of a round sits in slot ``k mod S`` for all its life: a torpedo is seen
+for ``torpedo_life - 1`` frames and a ship fires at most every ``max(reload, 1)`` frames, so
+the torpedoes sharing a slot are never in flight together. A smaller observation is less memory
+to write and to read for every agent-step, and fewer inputs to learn from.
 """
 import math
 
@@ -55,9 +60,25 @@ _TORPEDOES = _ENEMY + len(ENEMY)
 _NT = len(TORPEDO)
 
 
+@jit()
+def slots_in_flight(torpedoes, life, reload):
+    """The most torpedoes one ship can have in flight at once: a torpedo is in flight (seen)
+    for ``life - 1`` frames after the one it is fired in, and the next can be fired
+    ``max(reload, 1)`` frames later, so ``(life - 2) // max(reload, 1) + 1``, at most
+    ``torpedoes`` and at least 1."""
+    if life < 2:
+        return 1
+    return max(1, min(torpedoes, (life - 2) // max(reload, 1) + 1))
+
+
+def torpedo_slots(rules):
+    """S, the learning observation's torpedo slots per ship under these rules."""
+    return int(slots_in_flight(rules.torpedoes, rules.torpedo_life, rules.reload))
+
+
 def learning_length(rules):
     """D, the length of a learning observation under these rules."""
-    return _TORPEDOES + 2 * rules.torpedoes * _NT
+    return _TORPEDOES + 2 * torpedo_slots(rules) * _NT
 
 
 def learning_layout(rules):
@@ -65,7 +86,7 @@ def learning_layout(rules):
     names = list(HEADER) + [f"me.{f}" for f in OWN] + list(STAR)
     names += [f"enemy.{f}" for f in ENEMY]
     for owner in ("mine", "enemy"):
-        for k in range(rules.torpedoes):
+        for k in range(torpedo_slots(rules)):
             names += [f"torpedo.{owner}{k}.{f}" for f in TORPEDO]
     return names
 
@@ -110,7 +131,7 @@ def _write_gauges(out, o, m, s, ship_gauges, ship_counters, scales):
     out[o + 7] = ship_counters[m, s, core.IN_HYPER]
 
 
-@jit(_nrt=False)  # no reference counting: it allocates nothing (see core's note)
+@jit(_nrt=False, inline="always")  # allocates nothing; inlined (see core's note)
 def write_learning(m, seat, pos, vel, charge, active, ship_gauges, ship_counters, torp_life,
                    match_state, rules, scales, out):
     """Match ``m`` seen from ``seat`` as a learning observation, into ``out`` (float32, D)."""
@@ -151,23 +172,22 @@ def write_learning(m, seat, pos, vel, charge, active, ship_gauges, ship_counters
     out[e + 3] = (vel[m, 1, en] - vy0) * sv
     _write_gauges(out, e + 4, m, en, ship_gauges, ship_counters, scales)
     out[e + 12] = _sign(charge[m, en])
-    # the torpedo slots, own first
-    o = _TORPEDOES
+    # the torpedo slots, own first: the k-th torpedo in slot k mod S
+    slots = slots_in_flight(ntorp, int(rules[core.R_TLIFE]), int(rules[core.R_RELOAD]))
+    for j in range(_TORPEDOES, _TORPEDOES + 2 * slots * _NT):
+        out[j] = 0.0
     for row in range(2):
         owner = me if row == 0 else en
         for k in range(ntorp):
             b = 2 + owner * ntorp + k
             if active[m, b]:
+                o = _TORPEDOES + (row * slots + k % slots) * _NT
                 out[o] = 1.0
                 out[o + 1] = space.wrap_scalar(pos[m, 0, b] - x0, side) * sp
                 out[o + 2] = space.wrap_scalar(pos[m, 1, b] - y0, side) * sp
                 out[o + 3] = (vel[m, 0, b] - vx0) * sv
                 out[o + 4] = (vel[m, 1, b] - vy0) * sv
                 out[o + 5] = torp_life[m, owner * ntorp + k] * scales[11]
-            else:
-                for j in range(_NT):
-                    out[o + j] = 0.0
-            o += _NT
 
 
 @jit(parallel=False)
@@ -211,7 +231,7 @@ _BOT_MIX = np.uint64(0x2545F4914F6CDD1D)
 @jit(parallel=True)
 def step_learning(actions, pos, vel, mass, charge, radius, active, test, pinned, n, box, kinds,
                   params, param_offsets, indices, index_offsets, ship_gauges, ship_counters,
-                  torp_life, match_state, rng, rules, drifts, kicks, marks, scales, base,
+                  torp_life, match_state, rng, rules, drifts, kicks, scales, base,
                   episodes, frame_cap, mode, play, pending, observations, final_observations,
                   rewards, terminated, truncated, seats, memory, bot_rng):
     """One call for every match, matches spread over the threads in chunks.
@@ -237,30 +257,44 @@ def step_learning(actions, pos, vel, mass, charge, radius, active, test, pinned,
     for c in prange(chunks):
         scratch = core.new_scratch(pos)
         bot_scratch = compiled_bots.new_scratch(rules)
-        for m in range(c * matches // chunks, (c + 1) * matches // chunks):
-            if pending[m]:
-                _restart(m, state, ship_gauges, ship_counters, torp_life, match_state, rng,
-                         rules, base, episodes, seats, memory, bot_rng)
-                pending[m] = False
-                rewards[m, 0] = 0.0
-                rewards[m, 1] = 0.0
-                terminated[m] = False
-                truncated[m] = False
-            elif play:
-                _play_frame(m, actions, state, model, work, ship_gauges, ship_counters,
-                            torp_life, match_state, rng, rules, drifts, kicks, marks, scratch,
-                            frame_cap, seats, memory, bot_rng, bot_scratch, rewards, terminated,
-                            truncated)
-                if terminated[m] or truncated[m]:
-                    if mode == SAME_STEP:
-                        _observe(m, state, ship_gauges, ship_counters, torp_life, match_state,
-                                 rules, scales, final_observations, seats)
-                        _restart(m, state, ship_gauges, ship_counters, torp_life, match_state,
-                                 rng, rules, base, episodes, seats, memory, bot_rng)
-                    elif mode == NEXT_STEP:
-                        pending[m] = True
-            _observe(m, state, ship_gauges, ship_counters, torp_life, match_state, rules,
-                     scales, observations, seats)
+        _step_chunk(c * matches // chunks, (c + 1) * matches // chunks, actions, state, model,
+                    work, ship_gauges, ship_counters, torp_life, match_state, rng, rules, drifts,
+                    kicks, scales, base, episodes, frame_cap, mode, play, pending,
+                    observations, final_observations, rewards, terminated, truncated, seats,
+                    memory, bot_rng, scratch, bot_scratch)
+
+
+@jit(_nrt=False)
+def _step_chunk(first, last, actions, state, model, work, ship_gauges, ship_counters, torp_life,
+                match_state, rng, rules, drifts, kicks, scales, base, episodes, frame_cap,
+                mode, play, pending, observations, final_observations, rewards, terminated,
+                truncated, seats, memory, bot_rng, scratch, bot_scratch):
+    """Matches ``first`` to ``last - 1`` of ``step_learning``, in one thread's scratch: the
+    frame is inlined here, outside the parallel loop, whose compilation grows with its body."""
+    for m in range(first, last):
+        if pending[m]:
+            _restart(m, state, ship_gauges, ship_counters, torp_life, match_state, rng,
+                     rules, base, episodes, seats, memory, bot_rng)
+            pending[m] = False
+            rewards[m, 0] = 0.0
+            rewards[m, 1] = 0.0
+            terminated[m] = False
+            truncated[m] = False
+        elif play:
+            _play_frame(m, actions, state, model, work, ship_gauges, ship_counters,
+                        torp_life, match_state, rng, rules, drifts, kicks, scratch,
+                        frame_cap, seats, memory, bot_rng, bot_scratch, rewards, terminated,
+                        truncated)
+            if terminated[m] or truncated[m]:
+                if mode == SAME_STEP:
+                    _observe(m, state, ship_gauges, ship_counters, torp_life, match_state,
+                             rules, scales, final_observations, seats)
+                    _restart(m, state, ship_gauges, ship_counters, torp_life, match_state,
+                             rng, rules, base, episodes, seats, memory, bot_rng)
+                elif mode == NEXT_STEP:
+                    pending[m] = True
+        _observe(m, state, ship_gauges, ship_counters, torp_life, match_state, rules,
+                 scales, observations, seats)
 
 
 @jit(inline="always")
@@ -291,7 +325,7 @@ def _restart(m, state, ship_gauges, ship_counters, torp_life, match_state, rng, 
 
 @jit(inline="always")
 def _play_frame(m, actions, state, model, work, ship_gauges, ship_counters, torp_life,
-                match_state, rng, rules, drifts, kicks, marks, scratch, frame_cap, seats,
+                match_state, rng, rules, drifts, kicks, scratch, frame_cap, seats,
                 memory, bot_rng, bot_scratch, rewards, terminated, truncated):
     """One frame of match m and its rewards and ends (see ``step_learning``)."""
     for s in range(2):
@@ -302,7 +336,7 @@ def _play_frame(m, actions, state, model, work, ship_gauges, ship_counters, torp
     s0 = match_state[m, core.SCORE0]
     s1 = match_state[m, core.SCORE1]
     core.step_match(m, actions, state, model, work, ship_gauges, ship_counters, torp_life,
-                    match_state, rng, rules, drifts, kicks, marks, scratch)
+                    match_state, rng, rules, drifts, kicks, scratch)
     d0 = match_state[m, core.SCORE0] - s0
     d1 = match_state[m, core.SCORE1] - s1
     r = 0.0
@@ -469,17 +503,21 @@ def learning_vector(raw, rules, rounds):
             r["enemy.angular_velocity"] * s[4], r["enemy.fuel"] * s[5], r["enemy.torpedoes"] * s[6],
             r["enemy.hyperspace"] * s[7], r["enemy.alive"], r["enemy.in_hyperspace"],
             sign(r["enemy.charge"])]
-    for k in range(2 * rules.torpedoes):
+    slots = torpedo_slots(rules)
+    torpedoes = [[0.0] * _NT for _ in range(2 * slots)]
+    for k in range(2 * rules.torpedoes):  # the raw slots: own torpedoes in firing order, then the enemy's
         t = {f: r[f"torpedo{k}.{f}"] for f in ("present", "x", "y", "vx", "vy", "ttl")}
         if t["present"]:
-            out += [1.0, rel(t["x"] - x0), rel(t["y"] - y0), (t["vx"] - vx0) * sv,
-                    (t["vy"] - vy0) * sv, t["ttl"] * s[11]]
-        else:
-            out += [0.0] * _NT
+            row, fired = divmod(k, rules.torpedoes)
+            torpedoes[row * slots + fired % slots] = [
+                1.0, rel(t["x"] - x0), rel(t["y"] - y0), (t["vx"] - vx0) * sv,
+                (t["vy"] - vy0) * sv, t["ttl"] * s[11]]
+    for slot in torpedoes:
+        out += slot
     return np.array(out, dtype=np.float32)
 
 
-__all__ = ["learning_layout", "learning_length", "learning_scales", "learning_vector",
+__all__ = ["learning_layout", "learning_length", "torpedo_slots", "slots_in_flight", "learning_scales", "learning_vector",
            "write_learning", "write_all_learning", "episode_stream", "step_learning",
            "LearningBatch", "seat_kinds", "copy_rows", "AUTORESET_MODES", "NEXT_STEP", "SAME_STEP", "DISABLED",
            "EXTERNAL"]

@@ -87,24 +87,29 @@ def play_match(p1, p2, seed=0, rounds=5, rules=None, budget=DEFAULT_BUDGET,
                 faults[s].add(0, *seat.dead)
                 forfeits[s] = True
         actions = np.full((1, 2), core.NOOP, dtype=np.int64)
-        raws = [np.empty(raw_length(rules)) for _ in seats]  # every seat copies what it keeps
-        match_state = game.match_state
-        while not match_state[0, core.OVER] and not any(forfeits):
-            frame = int(match_state[0, core.FRAME])
+        raws = np.empty((2, raw_length(rules)))  # every seat copies what it keeps
+        for s in range(2):
+            game._write_raw(0, s, raws[s])
+        match_state = game.match_state[0]  # this loop's Python is most of a frame's cost
+        over, frame_index = core.OVER, core.FRAME
+        forfeited = any(forfeits)
+        while not match_state[over] and not forfeited:
             kinds = [0, 0]
             for s, seat in enumerate(seats):
-                code, fault = seat.act(game._write_raw(0, s, raws[s]))
+                code, fault = seat.act(raws[s])
                 actions[0, s] = code
                 if fault is not None:
-                    faults[s].add(frame, *fault)
+                    faults[s].add(int(match_state[frame_index]), *fault)
                     kinds[s] = 1 + FAULT_KINDS.index(fault[0])
                 if seat.dead is not None or faults[s].total >= max_faults:
-                    forfeits[s] = True
+                    forfeits[s] = forfeited = True
             if record:
                 fault_codes += bytes(kinds)
-            if any(forfeits):
+            if forfeited:
                 break
-            game._step_codes(actions)  # codes from protocol.action_code: already checked
+            # codes from protocol.action_code, already checked; the frame, then what each
+            # seat sees next, in one compiled call
+            game._step_one_codes(0, actions, raws)
             if record:
                 history += bytes((int(actions[0, 0]), int(actions[0, 1])))
             if on_frame is not None:

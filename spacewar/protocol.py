@@ -60,16 +60,37 @@ def action_code(action):
     """
     if not isinstance(action, Action):
         raise ValueError(f"not an Action: {type(action).__name__}")
-    turn = object.__getattribute__(action, "turn")
+    try:
+        if type(action) is not Action:
+            raise KeyError
+        # the common case, every seat every frame: Action itself has no descriptor that
+        # could stand in for a field, so its fields are its instance dict's entries
+        fields = action.__dict__
+        turn, thrust, fire = fields["turn"], fields["thrust"], fields["fire"]
+        hyperspace, flip = fields["hyperspace"], fields["flip"]
+    except KeyError:  # a subclass, or an instance with a field deleted
+        get = object.__getattribute__
+        turn, thrust, fire = get(action, "turn"), get(action, "thrust"), get(action, "fire")
+        hyperspace, flip = get(action, "hyperspace"), get(action, "flip")
     if type(turn) not in _TURN_TYPES or turn not in (-1, 0, 1):
         raise ValueError(f"turn must be -1, 0 or 1, got {_short_repr(turn)}")
-    code = int(turn) + 1
-    for name, weight in (("thrust", 3), ("fire", 6), ("hyperspace", 12), ("flip", 24)):
-        value = object.__getattribute__(action, name)
-        if type(value) not in (bool, np.bool_):
-            raise ValueError(f"{name} must be True or False, got {_short_repr(value)}")
-        code += weight * bool(value)
-    return code
+    if type(thrust) not in _BOOL_TYPES:
+        _not_a_bool("thrust", thrust)
+    if type(fire) not in _BOOL_TYPES:
+        _not_a_bool("fire", fire)
+    if type(hyperspace) not in _BOOL_TYPES:
+        _not_a_bool("hyperspace", hyperspace)
+    if type(flip) not in _BOOL_TYPES:
+        _not_a_bool("flip", flip)
+    return (int(turn) + 1 + (3 if thrust else 0) + (6 if fire else 0)
+            + (12 if hyperspace else 0) + (24 if flip else 0))
+
+
+_BOOL_TYPES = (bool, np.bool_)
+
+
+def _not_a_bool(name, value):
+    raise ValueError(f"{name} must be True or False, got {_short_repr(value)}")
 
 
 # exact types only: a subclass of int could answer anything to ``in`` and ``int()``
@@ -198,11 +219,6 @@ def raw_layout(rules):
     return names
 
 
-def _frozen(array):
-    array.setflags(write=False)
-    return array
-
-
 def _made(cls, fields):
     """An instance of the frozen dataclass ``cls`` holding ``fields`` (all of them), without
     its generated ``__init__``, which sets each field through ``object.__setattr__`` and was
@@ -237,9 +253,17 @@ def observation_from_raw(raw, rules, shown_rules=None):
     raw = np.asarray(raw, dtype=np.float64)
     if raw.shape != (raw_length(rules),):
         raise ValueError(f"raw observation must have shape ({raw_length(rules)},), got {raw.shape}")
-    raw = _frozen(raw.copy())  # the bot's own copy: pos, vel and star_pos are views of it
-    return _made(Observation, {"rules": rules if shown_rules is None else shown_rules,
-                               "_vector": None, "_raw": raw, "_scales": _scales(rules)})
+    return observation_of_copy(raw.copy(), rules, shown_rules)
+
+
+def observation_of_copy(raw, rules, shown_rules=None):
+    """``observation_from_raw`` for a caller that hands over a fresh float64 copy of the
+    right shape, which the observation keeps (read-only): the match loop's, every frame."""
+    raw.setflags(write=False)  # the bot's own copy: pos, vel and star_pos are views of it
+    obj = object.__new__(Observation)
+    obj.__dict__.update({"rules": rules if shown_rules is None else shown_rules,
+                         "_vector": None, "_raw": raw, "_scales": _scales(rules)})
+    return obj
 
 
 #: the fields ``_decode`` makes (every field of an Observation but the rules)

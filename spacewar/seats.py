@@ -37,7 +37,7 @@ import time
 from . import codes, confinement, wire
 from .batch_bots import is_batch_bot, one_match_bot
 from .bots import BotLoadError, absolute_spec, is_builtin, locate, make_bot
-from .protocol import observation_from_raw
+from .protocol import observation_of_copy
 
 FAULT_KINDS = ("raised", "invalid", "timeout", "crashed", "startup", "memory")
 _KIND_BY_STATUS = {wire.RAISED: "raised", wire.INVALID: "invalid", wire.MEMORY: "memory"}
@@ -151,8 +151,9 @@ class InlineSeat:
         return self.dead
 
     def act(self, raw):
-        """``(code, fault)``: fault is None or ``(kind, message)``."""
-        obs = observation_from_raw(raw, self._rules, self.rules)
+        """``(code, fault)``: fault is None or ``(kind, message)``. ``raw`` is the match's
+        (a float64 array of ``raw_length``); the bot gets its own copy."""
+        obs = observation_of_copy(raw.copy(), self._rules, self.rules)
         start = time.perf_counter()
         status, code, text = wire.ask(self.bot, obs)
         elapsed = time.perf_counter() - start

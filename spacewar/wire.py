@@ -96,7 +96,7 @@ def ask(bot, obs):
     match for a bot it calls directly (``spacewar.seats.InlineSeat``). The code comes from the
     answer's fields (``spacewar.protocol.action_code``), never from what its class says.
     """
-    if type(bot) is _single_from_batch():  # a batch bot playing one match: K = 1
+    if type(bot) is _SINGLE_FROM_BATCH[0]:  # a batch bot playing one match: K = 1
         return bot.answer(obs)
     try:
         result = bot.act(obs)
@@ -112,16 +112,9 @@ def ask(bot, obs):
         return INVALID, 0, exception_text(exc)
 
 
-_SINGLE_FROM_BATCH = []
-
-
-def _single_from_batch():
-    """``batch_bots.SingleFromBatch``, imported on first use (that module imports this one)."""
-    if not _SINGLE_FROM_BATCH:
-        from .batch_bots import SingleFromBatch
-
-        _SINGLE_FROM_BATCH.append(SingleFromBatch)
-    return _SINGLE_FROM_BATCH[0]
+#: ``batch_bots.SingleFromBatch`` once that module is imported (it imports this one, and sets
+#: it); until then no bot can be one, and the placeholder is a class no bot is an instance of
+_SINGLE_FROM_BATCH = [type("_NoSingleFromBatchYet", (), {})]
 
 
 def pack_answer(frame, status, code=0, text=""):

@@ -27,6 +27,14 @@ def accelerations(t, state, model, acc, work):
 
     A pinned particle gets its acceleration like any other (it exerts its forces and feels
     theirs); the integrators hold it still by masking its kicks and drifts."""
+    accelerations_inline(t, state, model, acc, work)
+
+
+@njit(cache=True, error_model="numpy", _nrt=False, inline="always")
+def accelerations_inline(t, state, model, acc, work):
+    """``accelerations``, inlined into its caller by numba. For executors that step many
+    small systems: a call to a compiled function with a dozen array arguments (each passed
+    as ten words) measured 25 to 165 ns, more than the forces on a few particles."""
     n = state.n
     for k in range(acc.shape[0]):
         for i in range(n):

@@ -22,7 +22,7 @@ same operations, bit for bit, without the general machinery's cost per step.
 import numpy as np
 from numba import njit
 
-from ..forces.dispatch import accelerations
+from ..forces.dispatch import accelerations_inline
 from . import fused_gravity
 from .common import OK, all_finite, copy_state, drift, fill_active_mask, first_nonfinite, kick
 
@@ -82,14 +82,14 @@ def advance(t, h, steps, state, model, work, vdep, t_end, drifts, kicks):
     return _advance_general(t, h, steps, state, model, work, vdep, drifts, kicks, scratch)
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@njit(cache=True, error_model="numpy", _nrt=False, inline="always")
 def advance_general_in(t, h, steps, state, model, work, vdep, drifts, kicks, scratch):
     """``advance`` by the general executor alone (every term through the dispatch table; the
     fused path gives the same bits for the scenes it takes), in caller-owned ``scratch`` of
     at least ``scratch_rows(dim)`` rows and ``n`` columns, compiled without reference
-    counting (``_nrt=False``, as the force kernels are: it allocates nothing): a compiled
-    caller stepping many small systems (the game's matches) allocates nothing per system and
-    pays no atomic updates per array on each call."""
+    counting (``_nrt=False``, as the force kernels are: it allocates nothing) and inlined
+    into its caller with the force table: a compiled caller stepping many small systems (the
+    game's matches) allocates nothing per system and pays no call per system."""
     return _advance_general(t, h, steps, state, model, work, vdep, drifts, kicks, scratch)
 
 
@@ -122,7 +122,7 @@ def _advance_general(t, h, steps, state, model, work, vdep, drifts, kicks, scrat
                 fresh = False
             if kicks[s] != 0.0:
                 if not fresh:
-                    accelerations(t_pos, state, model, acc, work)
+                    accelerations_inline(t_pos, state, model, acc, work)
                     fresh = True
                 kick(vel, acc, mask, n, kicks[s] * h)
                 if vdep:

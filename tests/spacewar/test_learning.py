@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from spacewar import Game, Rules
-from spacewar.learning import learning_layout, learning_length
+from spacewar.learning import learning_layout, learning_length, torpedo_slots
 
 
 def _played(rules, matches=6, frames=400, seed=3):
@@ -27,6 +27,39 @@ def test_the_compiled_observations_are_the_numpy_definition(mode):
         for seat in range(2):
             # cos and sin may round differently in compiled code: one float32 ulp at most
             np.testing.assert_array_max_ulp(obs[m, seat], game.learning_observation(m, seat), 1)
+
+
+@pytest.mark.parametrize("changes, slots, reached", [
+    ({}, 6, True),                                  # 1962: life 96, reload 16
+    ({"reload": 4, "torpedo_life": 30}, 8, True),   # 28 // 4 + 1
+    ({"reload": 0}, 32, False),                     # a torpedo every frame: up to all 32
+    ({"reload": 1, "torpedo_life": 12}, 11, False),
+    ({"reload": 5, "torpedo_life": 40, "single_shot": True}, 8, False),
+    ({"reload": 16, "torpedo_life": 17}, 1, True),
+])
+def test_the_torpedo_slots_hold_every_torpedo_in_flight(changes, slots, reached):
+    """S is the most torpedoes a ship can have in flight, so the torpedoes that share a slot
+    (k mod S) are never in flight together: ships that fire whenever they can, at the fastest
+    cadence the rules allow, never see a torpedo missing, and fill every slot where the
+    torpedoes fly far enough apart not to destroy each other."""
+    rules = Rules(**changes)
+    assert torpedo_slots(rules) == slots
+    game = Game(rules, seeds=range(4), rounds=3)
+    names = learning_layout(rules)
+    present = [k for k, name in enumerate(names) if name.endswith(".present")]
+    assert len(present) == 2 * slots
+    most = 0
+    for f in range(300):
+        fire = 6 + 1 if not rules.single_shot or f % 2 == 0 else 1  # fire, no turn; released
+        game.step(np.full((4, 2), fire))
+        obs = game.learning_observations()
+        live = game.active[:, 2:].reshape(4, 2, rules.torpedoes).sum(axis=2)
+        # every torpedo in flight has a slot of its own: as many present flags as torpedoes
+        seen = obs[:, :, present].reshape(4, 2, 2, slots).sum(axis=3)
+        np.testing.assert_array_equal(seen[:, 0, 0], live[:, 0])
+        np.testing.assert_array_equal(seen[:, 0, 1], live[:, 1])
+        most = max(most, int(live.max()))
+    assert most == slots if reached else most <= slots
 
 
 def test_layout_names_every_entry_and_values_stay_about_unit():

@@ -89,10 +89,10 @@ def test_the_saved_metadata_describes_the_policy(trained):
     policy = Policy.load(out)
     meta = policy.metadata
     assert meta["format_version"] == policy_mod.FORMAT_VERSION
-    assert meta["observation_length"] == 419 and meta["rules"] == Rules().to_dict()
+    assert meta["observation_length"] == 107 and meta["rules"] == Rules().to_dict()
     assert meta["action_format"] == "MultiDiscrete[3,2,2,2]" and meta["activation"] == "tanh"
     assert meta["frame_skip"] == SHORT.frame_skip and meta["training"]["opponent"] == "idle"
-    assert policy.inputs.size == 419 - 2  # the two entries scaled by the number of rounds
+    assert policy.inputs.size == 107 - 2  # the two entries scaled by the number of rounds
 
 
 def test_training_is_deterministic_for_a_seed(tmp_path):
