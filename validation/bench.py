@@ -462,9 +462,11 @@ def bench_batch(systems=4096, slots=66, repeats=5):
 
 # -- 8. Spacewar for learning code: spacewar.learning and spacewar.envs -----------------------
 def _vector_env_rate(opponent, matches, frames, repeats, seed=1, copy=True):
-    """Match-frames per second of ``SpacewarVectorEnv.step`` with random actions (the env's
-    own checks, the conversion of actions, observations, rewards and flags included) and
-    the final observations, so that runs at different thread counts can be compared."""
+    """Agent-steps per second of ``SpacewarVectorEnv(matches, ...).step`` with random actions
+    (the env's own checks, the conversion of actions, observations, rewards and flags
+    included; match-frames per second but in self-play, ``opponent=None``, where ``matches``
+    agents are ``matches / 2`` matches) and the final observations, so that runs at different
+    thread counts can be compared."""
     from spacewar.envs import SpacewarVectorEnv
 
     env = SpacewarVectorEnv(matches, opponent=opponent, max_frames=3000, copy=copy)
@@ -480,11 +482,13 @@ def _vector_env_rate(opponent, matches, frames, repeats, seed=1, copy=True):
     return matches * frames / best, obs
 
 
-def bench_learning(matches=4096, frames=50, repeats=3, opponents=("random", "chaser")):
+def bench_learning(matches=4096, frames=50, repeats=5, opponents=("random", "chaser")):
     """Match-frames per second, at 1 thread and at every thread, with the results compared
     between the two: ``LearningBatch.step`` (random actions; observations, rewards,
     terminations and resets included) and ``SpacewarVectorEnv.step`` against each compiled
-    opponent (the learner's actions random)."""
+    opponent (the learner's actions random), and in self-play (both seats learners: agent-steps
+    per second, two per match-frame). Each figure is the best of ``repeats`` runs: this
+    machine's speed varies by up to 2x from one minute to the next."""
     from spacewar.learning import LearningBatch, compiled_bots
 
     codes = np.random.default_rng(0).integers(0, 24, size=(frames, matches, 2))
@@ -508,6 +512,9 @@ def bench_learning(matches=4096, frames=50, repeats=3, opponents=("random", "cha
         rate, obs = _vector_env_rate("random", matches, frames, repeats, copy=False)
         row["vector_env_vs_random_no_copy_match_frames_per_second"] = rate
         final.append(obs.copy())
+        rate, obs = _vector_env_rate(None, 2 * matches, frames, repeats)  # 2 agents a match
+        row["vector_env_self_play_agent_steps_per_second"] = rate
+        final.append(obs.copy())
         rows[str(count)] = row
         finals.append(final)
     same = all(np.array_equal(a, b) for other in finals[1:] for a, b in zip(finals[0], other))
@@ -515,7 +522,7 @@ def bench_learning(matches=4096, frames=50, repeats=3, opponents=("random", "cha
             "identical_across_threads": bool(same), "harness": bench_harness()}
 
 
-def bench_harness(rounds=1, repeats=3):
+def bench_harness(rounds=1, repeats=5):
     """One match between two idle Python bots: the harness's own cost per frame, i.e. the
     match's wall time per frame less the two bots' ``act`` calls (timed alone on the same
     observations)."""
@@ -670,6 +677,10 @@ def targets(r):
                 rows.append((f"SpacewarVectorEnv.step vs {opponent}, {g['matches']} matches: "
                              f"at least {goal:.0e} match-frames/s", f"{fastest[key]:.2e}",
                              fastest[key] >= goal))
+        key = "vector_env_self_play_agent_steps_per_second"
+        if key in fastest:
+            rows.append((f"SpacewarVectorEnv.step in self-play, {g['matches']} matches: at least "
+                         "4e+06 agent-steps/s", f"{fastest[key]:.2e}", fastest[key] >= 4e6))
         h = g["harness"]["harness_seconds_per_frame"]
         rows.append(("one match of two idle Python bots: the harness's own cost at most 10 us "
                      "per frame", f"{h * 1e6:.1f} us", h <= 10e-6))
@@ -765,7 +776,10 @@ def format_report(r):
                              f"{row[f'vector_env_vs_{o}_match_frames_per_second']:.3e}"
                              for o in g["opponents"])
                          + f"; vs random with copy=False "
-                           f"{row['vector_env_vs_random_no_copy_match_frames_per_second']:.3e}")
+                           f"{row['vector_env_vs_random_no_copy_match_frames_per_second']:.3e}"
+                         + (f"; self-play {row['vector_env_self_play_agent_steps_per_second']:.3e}"
+                            " agent-steps/s"
+                            if "vector_env_self_play_agent_steps_per_second" in row else ""))
         h = g["harness"]
         lines.append(f"  one match of two idle Python bots: {h['seconds_per_frame'] * 1e6:.1f} us "
                      f"per frame, of which the bots' act {2 * h['act_seconds'] * 1e6:.2f} us: the "
@@ -883,12 +897,14 @@ def format_markdown(r, command):
                 + " at every thread count. Match-frames per second:", "",
                 "| threads | `LearningBatch.step` | "
                 + " | ".join(f"`SpacewarVectorEnv.step` vs {o}" for o in opponents)
-                + " | vs random, `copy=False` |",
-                "|---|---|" + "---|" * (len(opponents) + 1)]
+                + " | vs random, `copy=False` | self-play (agent-steps/s) |",
+                "|---|---|" + "---|" * (len(opponents) + 2)]
         out += [f"| {count} | {row['match_frames_per_second']:.3e} | " + " | ".join(
                     f"{row[f'vector_env_vs_{o}_match_frames_per_second']:.3e}"
                     for o in opponents)
-                + f" | {row['vector_env_vs_random_no_copy_match_frames_per_second']:.3e} |"
+                + f" | {row['vector_env_vs_random_no_copy_match_frames_per_second']:.3e} | "
+                + (f"{row['vector_env_self_play_agent_steps_per_second']:.3e}"
+                   if "vector_env_self_play_agent_steps_per_second" in row else "-") + " |"
                 for count, row in g["threads"].items()]
         h = g.get("harness")
         if h:
