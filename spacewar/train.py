@@ -74,12 +74,12 @@ class TrainConfig:
     seed: int = 0
     envs: int = 512              # matches played side by side
     rollout: int = 32            # decisions per env between updates
-    frame_skip: int = 8          # frames each decision is held for
+    frame_skip: int = 4          # frames each decision is held for
     rounds: int = 1              # rounds per training episode
     max_frames: int = 20000      # an episode is truncated after this many frames
     hidden: tuple = (128, 128)
     activation: str = "tanh"
-    gamma: float = 0.99          # per decision (8 frames): a horizon of ~800 frames
+    gamma: float = 0.99          # per decision (4 frames): a horizon of ~400 frames
     gae_lambda: float = 0.95
     clip: float = 0.2
     ent_coef: float = 0.005
