@@ -75,17 +75,6 @@ def advance_system(m, t, h, steps, state, model, work, vdep, drifts, kicks):
                              vdep, np.nan, drifts, kicks)
 
 
-@njit(cache=True, error_model="numpy", _nrt=False, inline="always")
-def advance_system_general_in(m, t, h, steps, state, model, work, vdep, drifts, kicks, scratch):
-    """``advance_system`` by the general executor alone (``splitting.advance_general_in``), in
-    caller-owned scratch (``splitting.scratch_rows(dim)`` rows by ``n``, reused from system to
-    system): nothing is allocated, and a caller compiled without reference counting
-    (``_nrt=False``) may call it. Same bits as ``advance_system``."""
-    return splitting.advance_general_in(t, h, steps, system_state(state, m),
-                                        system_model(model, m), work, vdep, drifts, kicks,
-                                        scratch)
-
-
 @njit(cache=True, error_model="numpy")
 def step_system(m, family, t, h, steps, state, model, work, vdep, tol, drifts, kicks):
     """System m advanced by the integrator ``family`` (SPLITTING with its coefficients,
@@ -596,5 +585,5 @@ def _family(name):
     return {"euler": EULER, "rk4": RK4, "rk45": RK45}[name], empty, empty
 
 
-__all__ = ["Batch", "advance_system", "advance_system_general_in", "step_system", "system_state", "system_model",
+__all__ = ["Batch", "advance_system", "step_system", "system_state", "system_model",
            "SPLITTING", "EULER", "RK4", "RK45"]

@@ -60,18 +60,17 @@ def action_code(action):
     """
     if not isinstance(action, Action):
         raise ValueError(f"not an Action: {type(action).__name__}")
-    try:
-        if type(action) is not Action:
-            raise KeyError
+    if type(action) is Action:
         # the common case, every seat every frame: Action itself has no descriptor that
         # could stand in for a field, so its fields are its instance dict's entries
         fields = action.__dict__
-        turn, thrust, fire = fields["turn"], fields["thrust"], fields["fire"]
-        hyperspace, flip = fields["hyperspace"], fields["flip"]
-    except KeyError:  # a subclass, or an instance with a field deleted
-        get = object.__getattribute__
-        turn, thrust, fire = get(action, "turn"), get(action, "thrust"), get(action, "fire")
-        hyperspace, flip = get(action, "hyperspace"), get(action, "flip")
+        try:
+            turn, thrust, fire = fields["turn"], fields["thrust"], fields["fire"]
+            hyperspace, flip = fields["hyperspace"], fields["flip"]
+        except KeyError:  # a field deleted: read as a subclass's are
+            turn, thrust, fire, hyperspace, flip = _looked_up_fields(action)
+    else:
+        turn, thrust, fire, hyperspace, flip = _looked_up_fields(action)
     if type(turn) not in _TURN_TYPES or turn not in (-1, 0, 1):
         raise ValueError(f"turn must be -1, 0 or 1, got {_short_repr(turn)}")
     if type(thrust) not in _BOOL_TYPES:
@@ -87,6 +86,14 @@ def action_code(action):
 
 
 _BOOL_TYPES = (bool, np.bool_)
+_FIELDS = ("turn", "thrust", "fire", "hyperspace", "flip")
+
+
+def _looked_up_fields(action):
+    """The five fields of an ``Action`` subclass (or of a forged instance) as the instance
+    holds them, whatever its class says of itself."""
+    get = object.__getattribute__
+    return tuple(get(action, name) for name in _FIELDS)
 
 
 def _not_a_bool(name, value):
