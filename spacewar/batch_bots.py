@@ -12,8 +12,10 @@ A batch bot is any object with ``act_batch(self, obs) -> codes``:
 It may define ``reset(self)``, called before the first frame. When its matches are played
 together (``spacewar.batch_match.play_matches``), the rows are its matches in a fixed order,
 every frame until the last one ends: the row of a finished match keeps its last observation
-and its action is ignored. Played one match at a time (``spacewar match``, a confined bot
-from a file), it is called with K = 1.
+and its action is ignored. A batch bot from a file plays so in its own confined process
+(``spacewar.seats.BatchProcessSeat``) when its class defines ``act_batch`` in its body
+(``spacewar.bots.declares_act_batch``). Played one match at a time (``spacewar match``), it
+is called with K = 1.
 
 A NumPy or PyTorch policy so plays hundreds of matches in one forward pass.
 """

@@ -4,7 +4,11 @@ Started by ``spacewar.seats.ProcessSeat`` as ``python -I -m spacewar.bothost IN 
 file descriptors of its two pipes), possibly under ``unshare``. Nothing of the bot runs
 before ``confinement.confine`` has applied every layer; from then on the bot's module is
 imported, its class checked, constructed and reset here, and the match only ever learns
-"ready" or a start-up fault with a message. Its answers are checked here for helpful messages,
+"ready" or a start-up fault with a message.
+
+Started with ``batch`` in its configuration (a count of matches), it hosts a batch bot
+(``spacewar.batch_bots``): one instance answers BATCH messages, all those matches' learning
+observations at once, with CODES. Its answers are checked here for helpful messages,
 and again by the match, which trusts nothing that arrives.
 """
 import io
@@ -67,10 +71,16 @@ def _load(config):
 
     if config.get("path"):
         sys.path.insert(0, config["path"])
-    from .batch_bots import one_match_bot
+    from .batch_bots import is_batch_bot, one_match_bot
 
     rules = Rules.from_dict(config["rules"])
-    bot = one_match_bot(make_bot(config["spec"], seed=config["seed"]), rules, config["rounds"])
+    bot = make_bot(config["spec"], seed=config["seed"])
+    if config.get("batch"):
+        if not is_batch_bot(bot):
+            raise TypeError(f"{config['spec']!r} defines act_batch in its source, but the bot "
+                            "it makes has no callable act_batch")
+    else:
+        bot = one_match_bot(bot, rules, config["rounds"])
     reset = getattr(bot, "reset", None)
     if callable(reset):
         reset()
@@ -81,6 +91,14 @@ def _answer(bot, rules, frame, raw):
     """The answer message of ``bot`` to the observation ``raw`` of ``frame``."""
     status, code, text = wire.ask(bot, observation_from_raw(raw, rules))
     return wire.pack_answer(frame, status, code, text)
+
+
+def _answer_batch(bot, call, obs):
+    """The CODES message of batch ``bot`` to the observations ``obs`` of ``call``."""
+    from .batch_bots import ask_batch
+
+    status, codes, text = ask_batch(bot, obs)
+    return wire.pack_codes(call, status, codes if status == wire.OK else b"", text)
 
 
 def main(argv):
@@ -111,18 +129,24 @@ def main(argv):
         _write_all(fd_out, wire.pack_answer(-1, wire.STARTUP, 0, wire.exception_text(exc)))
         os._exit(4)
     _write_all(fd_out, wire.pack_answer(-1, wire.READY, 0, "; ".join(layers)))
+    batch = bool(config.get("batch"))
+    read = wire.read_batch if batch else wire.read_observe
     while True:
         try:
-            message = wire.read_observe(lambda n: _read_exact(fd_in, n))
+            message = read(lambda n: _read_exact(fd_in, n))
         except (EOFError, OSError, ValueError):
             break
         if message is None:
             break
-        frame, raw = message
+        frame, observation = message
         try:
-            answer = _answer(bot, rules, frame, raw)
+            if batch:
+                answer = _answer_batch(bot, frame, observation)
+            else:
+                answer = _answer(bot, rules, frame, observation)
         except MemoryError:
-            answer = wire.pack_answer(frame, wire.MEMORY, 0, "MemoryError")
+            answer = (wire.pack_codes(frame, wire.MEMORY, b"", "MemoryError") if batch
+                      else wire.pack_answer(frame, wire.MEMORY, 0, "MemoryError"))
         try:
             _write_all(fd_out, answer)
         except OSError:

@@ -34,6 +34,8 @@ import sys
 import tempfile
 import time
 
+import numpy as np
+
 from . import codes, confinement, wire
 from .batch_bots import is_batch_bot, one_match_bot
 from .bots import BotLoadError, absolute_spec, is_builtin, locate, make_bot
@@ -199,6 +201,9 @@ def _bot_environment(scratch):
 class ProcessSeat:
     """A bot in its own confined process. Construction starts it; ``wait_ready`` waits."""
 
+    _batch_rows = 0  # a BatchProcessSeat's count of matches; 0: one match, asked with OBSERVE
+    _asked = "frame"  # what each question is called in fault messages
+
     def __init__(self, spec, seed, limits, rules, cpu_seconds=None, rounds=None):
         self.spec = spec
         self.limits = limits
@@ -239,7 +244,7 @@ class ProcessSeat:
         dirs, files = confinement.read_paths(extra_dirs=read_dirs)
         config = {
             "spec": absolute_spec(spec), "seed": int(seed), "rules": rules.to_dict(),
-            "rounds": self._rounds,
+            "rounds": self._rounds, "batch": self._batch_rows,
             "path": search_path, "output_bytes": limits.output_bytes,
             "confinement": {"numba_cache": _compiled_code_dirs(), "scratch": scratch,
                             "scratch_mb": limits.scratch_mb, "memory_mb": limits.memory_mb,
@@ -285,6 +290,8 @@ class ProcessSeat:
                                              f"{self.limits.startup:g} s")
             frame, status, code, text = answer
             if status == wire.READY and frame == -1:
+                if self._batch_rows:
+                    self._reader.rows = self._batch_rows  # CODES from now on
                 self._find_processes()
                 self.layers = [printable(x) for x in text.split("; ")][:16] if text else []
                 self._pause()  # it runs only on its turns from now on
@@ -311,41 +318,54 @@ class ProcessSeat:
                 self._pause()
 
     def _act(self, frame, raw):
+        answer, fault, elapsed = self._exchange(frame, wire.pack_observe(frame, raw),
+                                                self.limits.budget, self.bank.allowance())
+        if answer is None:
+            if elapsed is not None:  # silent for its whole allowance: the bank is spent
+                self.bank.left = 0.0
+            return codes.NOOP, fault
+        if not self.bank.charge(elapsed):
+            return codes.NOOP, ("timeout", self.bank.late(elapsed))
+        return self._judge(answer)
+
+    def _exchange(self, frame, message, budget, allowance):
+        """Send ``message`` (asking for ``frame``) and wait for the answer, at most
+        ``allowance`` s; a late answer to an earlier frame is waited for ``budget`` s first.
+
+        ``(answer, None, seconds)`` when it answered in time, else ``(None, fault,
+        seconds)``: ``seconds`` is the allowance when it said nothing for all of it, None
+        when it was not asked (still busy, dead, stopped)."""
         if self._pending is None and (self._reader.buffer or self._unsolicited()):
-            return codes.NOOP, self.dead or self._stop(
-                "invalid", "broke the protocol: answered before being asked")
+            return None, self.dead or self._stop(
+                "invalid", "broke the protocol: answered before being asked"), None
         self._resume()
         if self._pending is not None:
             late_frame, _ = self._pending
             window = time.monotonic()
-            answer = self._receive(window + self.limits.budget)
+            answer = self._receive(window + budget)
             self._busy_for += time.monotonic() - window
             if self.dead is not None:
-                return codes.NOOP, self.dead
+                return None, self.dead, None
             if answer is None:
-                if self._busy_for > self.bank.allowance() + self.limits.stop_after:
-                    return codes.NOOP, self._stop(
-                        "timeout", f"stopped: no answer to frame {late_frame} after "
-                                   f"{self._busy_for:.1f} s of its turns")
-                return codes.NOOP, ("timeout", f"still busy with frame {late_frame}")
+                if self._busy_for > allowance + self.limits.stop_after:
+                    return None, self._stop(
+                        "timeout", f"stopped: no answer to {self._asked} {late_frame} after "
+                                   f"{self._busy_for:.1f} s of its turns"), None
+                return None, ("timeout", f"still busy with {self._asked} {late_frame}"), None
             self._pending = None  # the late answer to an earlier frame: that one was a no-op
         sent = time.monotonic()
-        allowance = self.bank.allowance()
-        if not self._send(wire.pack_observe(frame, raw), sent + allowance):
-            return codes.NOOP, self.dead or self._stop("timeout", "did not read its observation")
+        if not self._send(message, sent + allowance):
+            return None, self.dead or self._stop("timeout", "did not read its observation"), None
         self._pending, self._busy_for = (frame, sent), 0.0
         answer = self._receive(sent + allowance)
         if answer is None:
             if self.dead is not None:
-                return codes.NOOP, self.dead
+                return None, self.dead, None
             self._busy_for = time.monotonic() - sent
-            self.bank.left = 0.0
-            return codes.NOOP, ("timeout", f"no answer within {allowance * 1e3:.1f} ms "
-                                           "(budget and overage bank)")
+            return None, ("timeout", f"no answer within {allowance * 1e3:.1f} ms "
+                                     "(budget and overage bank)"), allowance
         self._pending = None
-        if not self.bank.charge(time.monotonic() - sent):
-            return codes.NOOP, ("timeout", self.bank.late(time.monotonic() - sent))
-        return self._judge(answer)
+        return answer, None, time.monotonic() - sent
 
     def _unsolicited(self):
         """Whether the bot wrote anything while it was not asked (it is stopped now), or died."""
@@ -401,8 +421,8 @@ class ProcessSeat:
                 frame = answer[0]
                 expected = -1 if self._pending is None else self._pending[0]
                 if frame != expected:
-                    self._stop("invalid", f"broke the protocol: answered frame {frame}, "
-                                          f"asked {expected}")
+                    self._stop("invalid", f"broke the protocol: answered {self._asked} "
+                                          f"{frame}, asked {expected}")
                     return None
                 return answer
             remaining = deadline - time.monotonic()
@@ -543,6 +563,57 @@ class ProcessSeat:
                     os.close(fd)
                 except OSError:
                     pass
+
+
+class BatchProcessSeat(ProcessSeat):
+    """A batch bot from a file (``spacewar.batch_bots``) in its own confined process, one
+    instance answering for ``rows`` matches at once: every call sends all their learning
+    observations (BATCH) and takes one code per row back (CODES), with every protection and
+    deadline of ``ProcessSeat``. What the caller charges to each match is its business
+    (``spacewar.batch_match``); this seat judges only the answer."""
+
+    _asked = "call"
+
+    def __init__(self, spec, seed, limits, rules, rows, cpu_seconds=None, rounds=None):
+        if isinstance(rows, bool) or not isinstance(rows, int) or not 1 <= rows <= wire.MAX_ROWS:
+            raise ValueError(f"rows must be an int in [1, {wire.MAX_ROWS}], got {rows!r}")
+        self._batch_rows = rows
+        super().__init__(spec, seed, limits, rules, cpu_seconds=cpu_seconds, rounds=rounds)
+
+    def act_batch(self, call, obs, budget, allowance):
+        """Ask for call number ``call`` on ``obs`` ((rows, D) float32); never waits past
+        ``allowance`` s (a late answer to the previous call: ``budget`` s).
+
+        Returns ``(status, codes, text, seconds, fault)``: with an answer, ``status`` is the
+        wire's (``codes`` the (rows,) int64 codes when OK, else None; INVALID when the codes
+        are not ``rows`` valid ones), ``seconds`` how long it took and ``fault`` None; without
+        one, ``status`` is None and ``fault`` says why (``self.dead`` set when the bot can
+        play no more), ``seconds`` the allowance when it was silent for all of it."""
+        if self.dead is not None:
+            return None, None, "", None, self.dead
+        try:
+            answer, fault, seconds = self._exchange(call, wire.pack_batch(call, obs), budget,
+                                                    allowance)
+        finally:
+            if self.dead is None:
+                self._pause()
+        if answer is None:
+            return None, None, "", seconds, fault
+        _, status, data, text = answer
+        if status == wire.OK:
+            if len(data) != self._batch_rows:
+                return (wire.INVALID, None, f"answered {len(data)} action codes for "
+                        f"{self._batch_rows} matches", seconds, None)
+            found = np.frombuffer(data, dtype=np.uint8).astype(np.int64)
+            bad = found >= codes.N_ACTIONS
+            if bad.any():
+                return (wire.INVALID, None, f"action code {found[bad][0]} out of range "
+                        f"[0, {codes.N_ACTIONS})", seconds, None)
+            return wire.OK, found, "", seconds, None
+        if status in _KIND_BY_STATUS:
+            return status, None, text or wire.STATUS_NAMES[status], seconds, None
+        return None, None, "", None, self._stop(
+            "invalid", f"broke the protocol: status {wire.STATUS_NAMES[status]!r} during play")
 
 
 @functools.lru_cache(maxsize=None)

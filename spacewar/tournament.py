@@ -42,35 +42,48 @@ def schedule(bots, games, seed):
 def _play(job):
     """A job's outcomes ``[(result, timing), ...]``: one match, or every match of a pairing
     with a batch bot, played together (``spacewar.batch_match``)."""
-    matches, rounds, rules_dict, limits, max_faults, isolation = job
+    matches, together, rounds, rules_dict, limits, max_faults, isolation, batch_files = job
     rules = Rules.from_dict(rules_dict)
-    if len(matches) > 1:
+    if together:
         from .batch_match import play_matches
 
         return play_matches(matches, rounds=rounds, rules=rules, limits=limits,
-                            max_faults=max_faults)
+                            max_faults=max_faults, batch_files=batch_files)
     (p1, p2, match_seed), = matches
     result, _, timing = play_match(p1, p2, seed=match_seed, rounds=rounds, rules=rules,
                                    limits=limits, max_faults=max_faults, isolation=isolation)
     return [(result, timing)]
 
 
-def _jobs(schedule_, isolation):
-    """The schedule cut into jobs: each match alone, except that a pairing with a batch bot
-    (a policy file) and a bot that can share its game (``batch_match.can_play_together``)
-    is one job, all its matches in one game, the batch bot answering for all of them at
-    once. Built-in bots forced into processes (``isolation="process"``) play alone."""
+def batch_files_of(bots):
+    """The bots from files among ``bots`` that play as batch bots (their class defines
+    ``act_batch``: ``spacewar.bots.declares_act_batch``), read once for the whole run."""
+    from .bots import declares_act_batch
+
+    return frozenset(spec for spec in bots if declares_act_batch(spec))
+
+
+def _jobs(schedule_, isolation, batch_files=frozenset()):
+    """The schedule cut into jobs ``(matches, together)``: each match alone, except that a
+    pairing with a batch bot (a policy file, or a bot from a file in ``batch_files``) and a
+    bot that can share its game (``batch_match.can_play_together``) is one job, all its
+    matches in one game, the batch bot answering for all of them at once (at most
+    ``wire.MAX_ROWS`` matches a job). Under ``isolation="process"`` every match plays alone."""
     from .batch_match import can_play_together, is_batch_spec
+    from .wire import MAX_ROWS
 
     jobs = []
     for p1, p2, seed in schedule_:
-        together = (isolation != "process" and (is_batch_spec(p1) or is_batch_spec(p2))
-                    and can_play_together(p1) and can_play_together(p2))
-        if together and jobs and jobs[-1][0] and {p1, p2} == jobs[-1][2]:
+        together = (isolation != "process"
+                    and (is_batch_spec(p1, batch_files) or is_batch_spec(p2, batch_files))
+                    and can_play_together(p1, batch_files)
+                    and can_play_together(p2, batch_files))
+        if together and jobs and jobs[-1][0] and {p1, p2} == jobs[-1][2] \
+                and len(jobs[-1][1]) < MAX_ROWS // 2:
             jobs[-1][1].append((p1, p2, seed))
         else:
             jobs.append((together, [(p1, p2, seed)], {p1, p2}))
-    return [matches for _, matches, _ in jobs]
+    return [(matches, together) for together, matches, _ in jobs]
 
 
 def _worker_start():
@@ -135,8 +148,10 @@ def run_tournament(bots, games=10, seed=1, rounds=3, rules=None, workers=None, p
     if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
         raise ValueError(f"workers must be an int >= 1, got {workers!r}")
     limits = Limits(budget=budget) if limits is None else limits
-    jobs = [(matches, rounds, rules.to_dict(), limits, max_faults, isolation)
-            for matches in _jobs(schedule(bots, games, seed), isolation)]
+    batch_files = batch_files_of(bots)
+    jobs = [(matches, together, rounds, rules.to_dict(), limits, max_faults, isolation,
+             batch_files)
+            for matches, together in _jobs(schedule(bots, games, seed), isolation, batch_files)]
     total = sum(len(job[0]) for job in jobs)
     if workers > 1:
         _warm_up(rules)

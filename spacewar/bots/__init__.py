@@ -8,8 +8,10 @@ import importlib
 import importlib.machinery
 import importlib.util
 import inspect
+import io
 import os
 import sys
+import tokenize
 
 #: name -> "module:Class" of the built-in bots
 BUILTIN = {
@@ -103,6 +105,92 @@ def locate(spec):
         raise BotLoadError(f"module {top!r} for bot {spec!r} has no files to load")
     parents = sorted({os.path.dirname(os.path.abspath(r)) for r in roots})
     return roots, parents, (parents[0] if local else None)
+
+
+MAX_SOURCE_BYTES = 1 << 22  # a bot's source read for act_batch; a larger one plays as act
+
+
+def declares_act_batch(spec):
+    """Whether the class a bot specification names defines ``act_batch`` in its own body
+    (a ``def`` or an assignment at the class's top level), read from its source file without
+    running any of it. Such a bot from a file plays all its matches of a pairing in one
+    confined process, one call per frame (``spacewar.batch_match``); any other, one match at a
+    time. Only the source is read (tokenized: no parser recursion, nothing evaluated), so a
+    class that gets ``act_batch`` from a base class or at run time is not seen as one; a
+    file that cannot be read or tokenized, or is over ``MAX_SOURCE_BYTES``, is not either."""
+    if not isinstance(spec, str) or is_builtin(spec):
+        return False
+    try:
+        where, class_name = _split(spec)
+        path = os.path.abspath(where) if _is_file_spec(where) else _module_source(where)
+        if path is None or not path.endswith(".py"):
+            return False
+        with open(path, "rb") as f:
+            data = f.read(MAX_SOURCE_BYTES + 1)
+    except (BotLoadError, OSError, ImportError, ValueError):
+        return False
+    if len(data) > MAX_SOURCE_BYTES:
+        return False
+    try:
+        return _class_body_defines(data, class_name, "act_batch")
+    except (tokenize.TokenError, SyntaxError, ValueError, UnicodeDecodeError):
+        return False
+
+
+def _class_body_defines(source, class_name, attribute):
+    """Whether the last top-level ``class class_name`` of ``source`` (bytes) defines
+    ``attribute`` at its body's own level (``def attribute``, ``async def attribute``,
+    ``attribute = ...``, ``attribute: ... = ...``)."""
+    found = False
+    depth = 0  # indentation level
+    body = None  # the indentation level of the class's body while inside it
+    line = []  # the significant tokens of the current logical line so far
+    for token in tokenize.tokenize(io.BytesIO(source).readline):
+        kind, text = token.type, token.string
+        if kind == tokenize.INDENT:
+            depth += 1
+            continue
+        if kind == tokenize.DEDENT:
+            depth -= 1
+            if body is not None and depth < body:
+                body = None
+            continue
+        if kind in (tokenize.NEWLINE, tokenize.ENDMARKER):
+            if depth == 0 and line[:2] == ["class", class_name]:
+                body, found = 1, False  # a later class of that name replaces an earlier one
+            elif body is not None and depth == body and _defines(line, attribute):
+                found = True
+            line = []
+            continue
+        if kind in (tokenize.NL, tokenize.COMMENT, tokenize.ENCODING):
+            continue
+        if len(line) < 4:
+            line.append(text)
+    return found
+
+
+def _defines(line, attribute):
+    if line[:1] == ["async"]:
+        line = line[1:]
+    return line[:2] == ["def", attribute] or (line[:1] == [attribute] and line[1:2] in
+                                              (["="], [":"]))
+
+
+def _module_source(where):
+    """The source file of module ``where`` (dotted), found as ``locate`` finds it, without
+    importing anything."""
+    parts = where.split(".")
+    if not all(part.isidentifier() for part in parts):
+        return None
+    found = importlib.machinery.PathFinder.find_spec(parts[0], [os.getcwd()])
+    if found is None:
+        found = importlib.util.find_spec(parts[0])
+    for part in parts[1:]:
+        if found is None or not found.submodule_search_locations:
+            return None
+        found = importlib.machinery.PathFinder.find_spec(part,
+                                                         list(found.submodule_search_locations))
+    return None if found is None else found.origin
 
 
 def absolute_spec(spec):

@@ -127,3 +127,48 @@ def test_an_observation_is_decoded_when_first_read_with_the_raw_numbers():
     assert obs.torpedoes[0].pos.tolist() != [0.0, 0.0] and not obs.me.pos.flags.writeable
     with pytest.raises(AttributeError, match="no attribute 'nothing'"):
         obs.nothing
+
+
+def test_batch_and_codes_messages_round_trip():
+    obs = np.arange(12, dtype=np.float32).reshape(3, 4) / 7
+    view = memoryview(wire.pack_batch(9, obs) + wire.pack_stop())
+    pos = [0]
+
+    def read_exact(n):
+        chunk = bytes(view[pos[0]:pos[0] + n])
+        pos[0] += n
+        return chunk
+
+    call, got = wire.read_batch(read_exact)
+    assert call == 9 and got.dtype == np.float32 and np.array_equal(got, obs)
+    assert wire.read_batch(read_exact) is None  # STOP
+    reader = wire.AnswerReader(rows=3)
+    data = wire.pack_codes(9, wire.OK, [1, 47, 0]) + wire.pack_codes(10, wire.RAISED, b"", "x")
+    for byte in data:
+        reader.feed(bytes([byte]))
+        answer = reader.next()
+        if answer:
+            assert answer == (9, wire.OK, bytes([1, 47, 0]), "")
+            break
+    reader.feed(data[len(wire.pack_codes(9, wire.OK, [1, 47, 0])):])
+    assert reader.next() == (10, wire.RAISED, b"", "x")
+    with pytest.raises(wire.WireError, match="caps"):
+        wire.pack_batch(0, np.zeros((wire.MAX_ROWS + 1, 1), np.float32))
+
+
+@pytest.mark.parametrize("data, message", [
+    (wire.pack_answer(1, wire.OK, 3), "magic"),  # one match's answer where codes are due
+    (struct.pack("<4sqBBHI", b"SWC1", 1, wire.OK, 0, 0, 4) + bytes(4), "4 codes for a batch of 3"),
+    (struct.pack("<4sqBBHI", b"SWC1", 1, 77, 0, 0, 3) + bytes(3), "unknown answer status 77"),
+    (struct.pack("<4sqBBHI", b"SWC1", 1, wire.RAISED, 0, 5000, 0), "exceeds 1024"),
+])
+def test_malformed_codes_are_wire_errors(data, message):
+    reader = wire.AnswerReader(rows=3)
+    with pytest.raises(wire.WireError, match=message):
+        reader.feed(data)
+        reader.next()
+
+
+def test_a_flood_of_codes_is_refused_before_it_is_parsed():
+    with pytest.raises(wire.WireError, match="without being asked"):
+        wire.AnswerReader(rows=100).feed(wire.pack_codes(1, wire.OK, [0] * 100) * 20)
