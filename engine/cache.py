@@ -44,6 +44,29 @@ def source_hash(package="engine"):
     return digest.hexdigest()[:16]
 
 
+@functools.lru_cache(maxsize=None)
+def numpy_dot_kind():
+    """How numpy's ``a @ b`` of two float64 2-vectors rounds on this machine: ``"fused"``
+    (``fma(a1, b1, a0 b0)``, OpenBLAS's ddot kernel on CPUs it gives FMA kernels, e.g.
+    SkylakeX), ``"plain"`` (``a0 b0 + a1 b1``, e.g. its Haswell kernel on an AMD EPYC) or
+    ``"other"``. Measured once on 256 fixed pairs against the exact fused value (fractions).
+    Compiled code that mirrors numpy's arithmetic (``spacewar.compiled_bots.dot_blas``)
+    is compiled for the kind found, and the game's compiled-code directory is named by it."""
+    from fractions import Fraction
+
+    import numpy as np
+
+    rng = np.random.default_rng(20261202)
+    a, b = rng.normal(size=(256, 2)), rng.normal(size=(256, 2))
+    plain = fused = 0
+    for x, y in zip(a.tolist(), b.tolist()):
+        got = float(np.array(x) @ np.array(y))
+        head = x[0] * y[0]
+        plain += got == head + x[1] * y[1]
+        fused += got == float(Fraction(x[1]) * Fraction(y[1]) + Fraction(head))
+    return "fused" if fused == len(a) else "plain" if plain == len(a) else "other"
+
+
 KEEP = 6  # compiled-code directories kept (for the sources seen most recently) ...
 MIN_AGE = 24 * 3600  # ... and none younger than a day is removed (a long run may be using it)
 
@@ -53,6 +76,8 @@ def cache_dir(package="engine"):
     base = os.environ.get("NUMBA_CACHE_DIR") or os.path.join(
         os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache"),
         "nbody-spacewar")
+    if package == "spacewar":  # its bots mirror numpy's dot, which rounds by machine
+        return os.path.join(base, f"numba-{package}-{source_hash(package)}{numpy_dot_kind()[0]}")
     return os.path.join(base, f"numba-{package}-{source_hash(package)}")
 
 

@@ -274,7 +274,8 @@ def _ask_side(side, call, learning, live, match_state, actions, faults, banks, f
                 forfeits[m, s] = True
             elif share is not None:  # silent for the whole allowance: every bank is spent
                 banks[m][s].left = 0.0
-        elif status in _KIND_BY_STATUS and status != INVALID:
+        elif side.seat is None and status in _KIND_BY_STATUS and status != INVALID:
+            # no answer at all from code in this process; a confined bot's status is its own word
             faults[m][s].add(frame, _KIND_BY_STATUS[status], text)
         elif not banks[m][s].charge(share):
             faults[m][s].add(frame, "timeout", banks[m][s].late(share))

@@ -38,11 +38,14 @@ can be reproduced:
   ``math.hypot`` and numpy's ``np.hypot`` call) in the last bit about 4 times in 10^5.
   :func:`py_hypot` re-implements CPython's algorithm; ``np.hypot`` in the reference
   (``lead_intercept``, the dodger's star pull) stays ``math.hypot`` here.
-* numpy's ``a @ b`` of two 2-vectors goes to OpenBLAS's ``ddot``, whose kernel on this
-  machine (Haswell and later) computes ``fma(a1, b1, a0 b0)``: a quarter of the time that
-  differs from ``a0 b0 + a1 b1`` in the last bit. :func:`dot_blas` uses the same fused
-  multiply-add (LLVM's ``llvm.fma.f64``, correctly rounded everywhere). On a machine whose
-  BLAS does not fuse, the reference changes and this mirror is off by one rounding there.
+* numpy's ``a @ b`` of two 2-vectors goes to OpenBLAS's ``ddot``, whose kernel is chosen
+  by CPU: on some (SkylakeX kernels) it computes ``fma(a1, b1, a0 b0)``, which a quarter of
+  the time differs from ``a0 b0 + a1 b1`` in the last bit; on others (its Haswell kernel on
+  an AMD EPYC) it computes the plain sum. ``engine.cache.numpy_dot_kind`` measures which at
+  import, and :func:`dot_blas` is compiled to match (the fused form with LLVM's
+  ``llvm.fma.f64``, correctly rounded everywhere); the game's compiled-code directory is
+  named by the kind. On a machine with a third rounding, the plain sum is used and this
+  mirror is off by one rounding there.
   Sums written with ``(a * b).sum(axis=1)`` or ``x * x + y * y`` stay plain.
 * ``np.cos`` / ``np.sin`` of float64 agree with ``math.cos`` / ``math.sin`` (the C library)
   on this machine (checked on 2e5 angles); Python's ``%`` on floats and numpy's remainder
@@ -79,6 +82,7 @@ from numba.core import types
 from numba.extending import intrinsic
 
 from engine import space
+from engine.cache import numpy_dot_kind
 from engine.analytic import kepler_step
 
 from . import core
@@ -121,6 +125,7 @@ _P_THRUST, _P_FIRE, _P_HYPER = (RANDOM_PARAMS[k] for k in ("thrust", "fire", "hy
 D_HORIZON, D_DANGER, D_CLEARANCE, D_HYPER_FRAMES, D_THRUST_CONE = DODGER_PARAMS.values()
 
 NUMERIC = {"error_model": "numpy"}  # a zero division gives inf / nan as numpy would, no raise
+DOT_FUSED = numpy_dot_kind() == "fused"  # how numpy's 2-vector dot rounds here (dot_blas)
 
 
 # -- the reference's arithmetic ----------------------------------------------------------------
@@ -136,8 +141,11 @@ def fma(typingctx, x, y, z):
 
 @jit(inline="always", **NUMERIC)
 def dot_blas(ax, ay, bx, by):
-    """numpy's ``a @ b`` for 2-vectors as OpenBLAS's ddot computes it here: fma(a1, b1, a0 b0)."""
-    return fma(ay, by, ax * bx)
+    """numpy's ``a @ b`` for 2-vectors as OpenBLAS's ddot computes it on this machine:
+    ``fma(a1, b1, a0 b0)`` or ``a0 b0 + a1 b1`` (``DOT_FUSED``, a constant when compiled)."""
+    if DOT_FUSED:
+        return fma(ay, by, ax * bx)
+    return ax * bx + ay * by
 
 
 @jit(**NUMERIC)

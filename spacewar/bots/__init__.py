@@ -10,6 +10,7 @@ import importlib.util
 import inspect
 import io
 import os
+import stat
 import sys
 import tokenize
 
@@ -107,7 +108,7 @@ def locate(spec):
     return roots, parents, (parents[0] if local else None)
 
 
-MAX_SOURCE_BYTES = 1 << 22  # a bot's source read for act_batch; a larger one plays as act
+MAX_SOURCE_BYTES = 1 << 20  # a bot's source read for act_batch; a larger one plays as act
 
 
 def declares_act_batch(spec):
@@ -117,7 +118,9 @@ def declares_act_batch(spec):
     confined process, one call per frame (``spacewar.batch_match``); any other, one match at a
     time. Only the source is read (tokenized: no parser recursion, nothing evaluated), so a
     class that gets ``act_batch`` from a base class or at run time is not seen as one; a
-    file that cannot be read or tokenized, or is over ``MAX_SOURCE_BYTES``, is not either."""
+    file that is not a regular file, cannot be read or tokenized (the first error token
+    ends the reading: the tokenizer can take time quadratic in a broken line), or is over
+    ``MAX_SOURCE_BYTES``, is not either."""
     if not isinstance(spec, str) or is_builtin(spec):
         return False
     try:
@@ -125,15 +128,21 @@ def declares_act_batch(spec):
         path = os.path.abspath(where) if _is_file_spec(where) else _module_source(where)
         if path is None or not path.endswith(".py"):
             return False
-        with open(path, "rb") as f:
-            data = f.read(MAX_SOURCE_BYTES + 1)
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_CLOEXEC)
+        try:
+            if not stat.S_ISREG(os.fstat(fd).st_mode):
+                return False  # a FIFO, a device, a directory: never read
+            with os.fdopen(fd, "rb", closefd=False) as f:
+                data = f.read(MAX_SOURCE_BYTES + 1)
+        finally:
+            os.close(fd)
     except (BotLoadError, OSError, ImportError, ValueError):
         return False
     if len(data) > MAX_SOURCE_BYTES:
         return False
     try:
         return _class_body_defines(data, class_name, "act_batch")
-    except (tokenize.TokenError, SyntaxError, ValueError, UnicodeDecodeError):
+    except Exception:  # anything the tokenizer or a codec cookie raises: not a batch bot
         return False
 
 
@@ -147,6 +156,8 @@ def _class_body_defines(source, class_name, attribute):
     line = []  # the significant tokens of the current logical line so far
     for token in tokenize.tokenize(io.BytesIO(source).readline):
         kind, text = token.type, token.string
+        if kind == tokenize.ERRORTOKEN:
+            return False  # not Python; going on could take time quadratic in a line
         if kind == tokenize.INDENT:
             depth += 1
             continue

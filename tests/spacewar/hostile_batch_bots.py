@@ -133,3 +133,14 @@ class Pretender:
 
     def act_batch(self, obs):  # noqa: F811 (the point of the bot)
         return np.zeros(len(obs), dtype=np.int64)
+
+
+class ThinksThenRaises(Steady):
+    """Thinks for most of its allowance, then says it raised: a confined bot's word that it
+    raised is no reason to charge it nothing (found by a red team: it banked free thinking)."""
+
+    def act_batch(self, obs):
+        end = time.perf_counter() + 0.2 * len(obs)
+        while time.perf_counter() < end:
+            pass
+        raise RuntimeError("thought for free")

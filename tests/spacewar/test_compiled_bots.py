@@ -13,6 +13,7 @@ import math
 import numpy as np
 import pytest
 
+from engine.cache import numpy_dot_kind
 from spacewar import compiled_bots as cb, core
 from spacewar.bots import chaser, dodger, random_bot, sniper
 from spacewar.game import Game
@@ -243,7 +244,10 @@ def test_reference_arithmetic():
     xy = rng.normal(size=(20000, 2)) * np.exp(rng.uniform(-15, 2, size=(20000, 1)))
     assert all(cb.py_hypot(x, y) == math.hypot(x, y) for x, y in xy)
     other = rng.normal(size=(20000, 2))
-    assert all(cb.dot_blas(a[0], a[1], b[0], b[1]) == float(a @ b) for a, b in zip(xy, other))
+    same = sum(cb.dot_blas(a[0], a[1], b[0], b[1]) == float(a @ b) for a, b in zip(xy, other))
+    if numpy_dot_kind() == "other":
+        pytest.skip(f"numpy's 2-vector dot rounds neither plain nor fused here ({same} of 20000)")
+    assert same == 20000, numpy_dot_kind()
     r = Rules()
     assert (0.5 * r.star_capture) ** 2 == (0.5 * r.star_capture) * (0.5 * r.star_capture)
     assert (1.2 * r.star_capture) ** 2 == (1.2 * r.star_capture) * (1.2 * r.star_capture)

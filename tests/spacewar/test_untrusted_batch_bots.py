@@ -121,6 +121,15 @@ def test_a_slow_batch_is_late_for_every_match_and_a_silent_one_is_stopped():
         assert f["last"]["message"].startswith("stopped: no answer to call 0")
 
 
+def test_a_confined_bot_saying_it_raised_is_still_charged_its_time():
+    results = [r for r, _ in play_matches([(f"{B}:ThinksThenRaises", "idle", 1),
+                                           ("idle", f"{B}:ThinksThenRaises", 2)],
+                                          rounds=1, rules=SHORT, limits=FAST, max_faults=25)]
+    for s, r in enumerate(results):  # 0.4 s a call against 0.1 s of budget: its bank is spent
+        f = r["faults"][s]
+        assert r["forfeits"][s] and f["raised"] >= 1 and f["timeout"] >= 20, f
+
+
 def test_a_bot_that_loses_act_batch_when_made_is_a_start_up_fault():
     results = [r for r, _ in play_matches(_jobs_with(f"{B}:Pretender"), rounds=1, rules=SHORT,
                                           limits=ROOMY)]
@@ -164,7 +173,26 @@ def test_the_class_body_decides_what_plays_as_a_batch_bot(tmp_path):
                      "Twice": False, "Missing": False}
     (tmp_path / "bad.py").write_text("class Base:\n  def act_batch(self):\n pass\n")
     huge = tmp_path / "huge.py"
-    huge.write_bytes(b"class Base:\n    def act_batch(self, obs): pass\n" + b"#" * (1 << 22))
+    huge.write_bytes(b"class Base:\n    def act_batch(self, obs): pass\n" + b"#" * (1 << 20))
     assert not declares_act_batch(f"{tmp_path / 'bad.py'}:Base")  # does not tokenize
     assert not declares_act_batch(f"{huge}:Base")  # over the cap: read no further
     assert not declares_act_batch("chaser") and not declares_act_batch(f"{tmp_path}/no.py:X")
+
+
+def test_sources_made_to_hang_or_crash_the_reading_are_read_as_no_batch_bot(tmp_path):
+    """Found by a red team: a codec cookie that is no text encoding (LookupError), a line
+    on which the tokenizer takes quadratic time, a FIFO that never gives its bytes."""
+    import os
+
+    from spacewar.bots import declares_act_batch
+
+    body = b"class B:\n    def act_batch(self, obs):\n        return [0] * len(obs)\n"
+    (tmp_path / "rot13.py").write_bytes(b"# coding: rot13\n" + body)
+    (tmp_path / "slow.py").write_bytes(body + b"x = '" + b"\\'" * 100_000 + b"\n")
+    os.mkfifo(tmp_path / "fifo.py")
+    for name in ("rot13", "slow", "fifo"):
+        assert not declares_act_batch(f"{tmp_path / name}.py:B"), name
+    (tmp_path / "plain.py").write_bytes(body)
+    assert declares_act_batch(f"{tmp_path / 'plain.py'}:B")
+    with pytest.raises(ValueError, match="plays with play_match"):
+        play_matches([(f"{tmp_path / 'fifo.py'}:B", "idle", 1)], rounds=1, rules=SHORT)
