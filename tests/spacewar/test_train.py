@@ -19,10 +19,10 @@ from spacewar.train import TrainConfig  # noqa: E402
 
 # A short seeded run against the random bot, stopped by frames (not the clock) so it is the
 # same run every time on one kind of CPU: 20 M frames, each decision held for 8 frames, about
-# 45 s of training on two cores of an AMD EPYC (plus compiling). Its episodes are one round; the
+# 45 s of training on two cores of an AMD EPYC (znver5; plus compiling). Its episodes are one round; the
 # random bot flies, turns and fires at random. XLA's CPU code (and so the run) differs with the
-# CPU's vector unit: seed 1 won 46 of the 50 matches below on an AVX-512 machine and 36 on the
-# AVX2 one, where seeds 2 and 3 won 45 and 42. Measured there for seed 2: the untrained policy
+# CPU's vector unit: seed 1 won 46 of the 50 matches below on one AMD EPYC (znver4) and 36 on
+# others (znver5), where seeds 2 and 3 won 45 and 42. Measured there for seed 2: the untrained policy
 # wins 2 of the 50 matches, the trained one 45.
 SHORT = TrainConfig(opponent="random", minutes=30.0, steps=20_000_000, seed=2, envs=512,
                     frame_skip=8)
