@@ -17,11 +17,11 @@ with project_cache("engine"):
     from .atomic import OutputPathError, atomic_write, check_output_dir, check_output_path
     from .clock import FixedStepClock
     from .errors import SimulationError
-    from .integrators import INTEGRATORS, ORDERS, SYMPLECTIC
+    from .integrators import ADAPTIVE_INTEGRATORS, INTEGRATORS, ORDERS, SYMPLECTIC
     from .simulation import Simulation
 
 __version__ = "0.1.0"
 
-__all__ = ["Simulation", "Batch", "space", "state", "SimulationError", "INTEGRATORS", "ORDERS", "SYMPLECTIC", "forces", "integrators",
+__all__ = ["Simulation", "Batch", "space", "state", "SimulationError", "INTEGRATORS", "ADAPTIVE_INTEGRATORS", "ORDERS", "SYMPLECTIC", "forces", "integrators",
            "analytic", "clock", "diagnostics", "stability", "FixedStepClock", "__version__", "atomic",
            "atomic_write", "check_output_path", "check_output_dir", "OutputPathError"]

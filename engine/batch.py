@@ -167,6 +167,10 @@ class Batch(DeclaresTerms):
             raise ValueError(f"dim must be 2 or 3, got {dim!r}")
         capacity = int_in_range("capacity", capacity, 0, 2 ** 31)
         self._integrator = _integrators.check_name(integrator)
+        if self._integrator not in _integrators.GENERAL:
+            raise ValueError(f"integrator {integrator!r} is not available in a Batch (one of "
+                             f"{', '.join(_integrators.GENERAL)}); step separate Simulations "
+                             "with it")
         dt = finite_float("dt", dt)
         if dt == 0.0:
             raise ValueError("dt must be non-zero (negative runs backwards), got 0.0")

@@ -14,6 +14,7 @@ from ._validate import MAX_STEPS, finite_float, nonnegative_float, positive_floa
 from .errors import SimulationError
 from .forces.base import DeclaresTerms
 from .forces.dispatch import pack, potential_terms
+from .integrators import wisdom_holman
 from .particles import Particles
 from .space import check_box
 from .state import INVALID_FIELDS, first_invalid
@@ -40,6 +41,10 @@ class Simulation(DeclaresTerms):
     box : side L of a periodic space, the torus [-L/2, L/2)^dim (``None``: open space). The
         drift wraps positions onto it and every pair force and collision takes separations
         by the nearest image (``engine.space``).
+    corrector : ``whfast``'s symplectic corrector order, one of
+        ``engine.integrators.wisdom_holman.CORRECTORS`` (0: none; 3, 5, 7, 11, 17)
+    kernel : ``whfast``'s kernel, ``"standard"`` or ``"lazy"`` (the lazy implementer's
+        modified kick, one more force evaluation per step)
 
     ``pos``, ``vel``, ``mass``, ``charge`` and ``radius`` are writable views of the state. A
     step first checks them: a non-finite value written there (or a negative mass or radius)
@@ -48,9 +53,11 @@ class Simulation(DeclaresTerms):
     """
 
     def __init__(self, dim=2, integrator="symplectic_euler", dt=1.0, tolerance=1e-9,
-                 units=None, G=None, capacity=16, box=None):
+                 units=None, G=None, capacity=16, box=None, corrector=0, kernel="standard"):
         if isinstance(dim, bool) or dim not in (2, 3):
             raise ValueError(f"dim must be 2 or 3, got {dim!r}")
+        self._corrector = _check_corrector(corrector)
+        self._kernel = _check_kernel(kernel)
         self._units = None if units is None else UnitSystem(units)
         self._integrator = _integrators.check_name(integrator)
         self._dt = self._check_dt(dt)
@@ -97,6 +104,24 @@ class Simulation(DeclaresTerms):
         if value == 0.0:
             raise ValueError("dt must be non-zero (negative runs backwards), got 0.0")
         return value
+
+    @property
+    def corrector(self):
+        """``whfast``'s symplectic corrector order (0: none)."""
+        return self._corrector
+
+    @corrector.setter
+    def corrector(self, value):
+        self._corrector = _check_corrector(value)
+
+    @property
+    def kernel(self):
+        """``whfast``'s kernel: ``"standard"`` or ``"lazy"``."""
+        return self._kernel
+
+    @kernel.setter
+    def kernel(self, value):
+        self._kernel = _check_kernel(value)
 
     @property
     def tolerance(self):
@@ -356,9 +381,14 @@ class Simulation(DeclaresTerms):
                              "largest float (t would not be finite); nothing was changed")
         state, model = self.kernel_arguments()
         self._check_state(state)
+        plan = None
+        if self._integrator in _integrators.KEPLER_SPLITTING:
+            plan = wisdom_holman.plan(self._forces, state, model,
+                                      lambda terms: pack(terms, self))
         vdep = any(f.velocity_dependent for f in self._forces)
         t, h_next, done, status = _integrators.advance(
-            self._integrator, self._t, h, steps, state, model, vdep, t_end, self._tolerance)
+            self._integrator, self._t, h, steps, state, model, vdep, t_end, self._tolerance,
+            plan=plan, corrector=self._corrector, kernel=self._kernel)
         failed_step = self.steps + done
         self._t = t
         self.steps += done
@@ -488,3 +518,16 @@ def _flags(field, value, k):
 
 
 __all__ = ["Simulation"]
+
+
+def _check_corrector(value):
+    if isinstance(value, bool) or value not in wisdom_holman.CORRECTORS:
+        raise ValueError(f"corrector must be one of {wisdom_holman.CORRECTORS}, got {value!r}")
+    return int(value)
+
+
+def _check_kernel(value):
+    if value not in wisdom_holman.KERNELS:
+        raise ValueError(f"kernel must be one of {', '.join(map(repr, wisdom_holman.KERNELS))}, "
+                         f"got {value!r}")
+    return value

@@ -121,6 +121,8 @@ def amplification_matrix(integrator, z):
     (x, v / omega): ``[x, v/omega]_{n+1} = G(z) [x, v/omega]_n``. ``z`` may be an array (the
     matrices are then stacked on the last two axes)."""
     check_name(integrator)
+    # whfast's kick of a perturbation is leapfrog's (drift-kick-drift) on that perturbation
+    integrator = _SAME_LIMIT.get(integrator, integrator)
     z = np.asarray(z, dtype=np.float64)
     one, zero = np.ones_like(z), np.zeros_like(z)
     if integrator in SCHEMES:
@@ -148,8 +150,13 @@ def amplification_matrix(integrator, z):
     return eye + sum(b[s] * stages[s] for s in range(len(b)))
 
 
+#: integrators whose step limit on an oscillator in their kick is another's
+_SAME_LIMIT = {"whfast": "leapfrog"}
+
+
 def _stable(integrator, z, slack=0.0):
     g = amplification_matrix(integrator, z)
+    integrator = _SAME_LIMIT.get(integrator, integrator)
     if integrator in SCHEMES:
         # det G = 1 (symplectic): stable while both eigenvalues stay on the unit circle
         return np.abs(g[..., 0, 0] + g[..., 1, 1]) <= 2.0 + slack

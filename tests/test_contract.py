@@ -24,8 +24,11 @@ def test_engine_contract():
     for value in (sim.energy(), sim.kinetic_energy(), sim.potential_energy()):
         assert math.isfinite(value)
     assert sim.momentum().shape == (2,) and isinstance(sim.angular_momentum(), float)
-    assert engine.INTEGRATORS == ("euler", "symplectic_euler", "leapfrog", "verlet", "rk4",
-                                  "yoshida4", "pefrl", "rk45")
+    assert engine.INTEGRATORS[:8] == ("euler", "symplectic_euler", "leapfrog", "verlet", "rk4",
+                                      "yoshida4", "pefrl", "rk45")
+    assert "whfast" in engine.INTEGRATORS
+    assert set(engine.ADAPTIVE_INTEGRATORS) <= set(engine.INTEGRATORS)
+    assert "rk45" in engine.ADAPTIVE_INTEGRATORS
     Simulation(integrator="rk45", dt=0.01, tolerance=1e-10)
     s3 = Simulation(dim=3, units=("AU", "yr", "Msun"))
     assert s3.G == pytest.approx(39.478, rel=1e-3)

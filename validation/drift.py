@@ -107,7 +107,7 @@ def jobs(level):
     n_per = level.drift_steps_per_orbit
     total = int(level.drift_orbits * n_per)
     common = f"{n_per} steps/orbit"
-    for name in engine.INTEGRATORS:
+    for name in engine.integrators.GENERAL:
         if name == "rk45":
             out.append(Job(("drift", "kepler", "engine", name, ""), "drift:run_engine_adaptive",
                            dict(problem=p, tolerance=level.drift_tolerance,
@@ -144,7 +144,7 @@ def jobs(level):
     dt = level.drift_solar_dt
     total = int(round(level.drift_solar_days / dt))
     common = f"dt = {dt:g} d"
-    for name in engine.INTEGRATORS:
+    for name in engine.integrators.GENERAL:
         if name == "rk45":
             out.append(Job(("drift", "solar", "engine", name, ""), "drift:run_engine_adaptive",
                            dict(problem=s, tolerance=level.drift_tolerance,
@@ -225,7 +225,7 @@ def assemble(level, results):
                 "growth_exponent": slope, "fit_window": window, "envelope_at_fit_end": env_end,
                 "destroyed_at": destroyed, "class": classify(slope, env_end or 0.0, window),
             })
-        order = list(engine.INTEGRATORS) + ["ias15", "whfast"]
+        order = list(engine.integrators.GENERAL) + ["ias15", "whfast"]
         runs.sort(key=lambda r: (r["code"] != "engine", order.index(r["integrator"]), r["steps"]))
         section[pkey] = {"title": problem.title, "time_unit": problem.unit,
                          "time_unit_name": problem.unit_name, "runs": runs}

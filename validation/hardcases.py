@@ -22,7 +22,7 @@ from .problems import (FIGURE_EIGHT_PERIOD, PYTHAGOREAN_ENERGY, Problem, figure_
                        make_sim, pythagorean)
 from .reference import RebRun
 
-FIXED = tuple(name for name in engine.INTEGRATORS if name != "rk45")
+FIXED = tuple(name for name in engine.integrators.GENERAL if name != "rk45")
 
 CASES = {
     "e099": {
@@ -450,7 +450,7 @@ ADAPTIVE = {  # rk45 tolerances (and IAS15 epsilons) per case
 
 def jobs(level):
     out = []
-    for name in engine.INTEGRATORS:
+    for name in engine.integrators.GENERAL:
         adaptive = name == "rk45"
         for s in ADAPTIVE["e099"] if adaptive else level.hc_e099_steps:
             out.append(Job(("hc", "e099", name, s), "hardcases:e099_job",
@@ -524,7 +524,7 @@ def assemble(level, results):
             outcomes.setdefault(key[2], {})[key[3]] = res
     section["spring_limits"] = {
         name: {"theory": theory_limit(name), "measured": limits.get(name, {})}
-        for name in engine.INTEGRATORS}
+        for name in engine.integrators.GENERAL}
     section["spring_outcomes"] = outcomes
     section["spring_dt"] = 0.01
     section["spring_steps"] = level.hc_spring_steps

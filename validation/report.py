@@ -37,7 +37,7 @@ def warm_up():
     time (numba's cache files are not safe against two processes compiling into them at once).
     """
     p = kepler(0.5)
-    for name in engine.INTEGRATORS:
+    for name in engine.integrators.GENERAL:
         sim = make_sim(p, name, 0.01)
         sim.step(2)
         sim.integrate(0.05)
@@ -98,7 +98,7 @@ def meta(level, workers):
         "rebound_version": rebound_version(), "numpy_version": np.__version__,
         "numba_version": numba.__version__, "python_version": platform.python_version(),
         "machine": platform.machine(), "cpu_count": os.cpu_count(), "workers": workers,
-        "integrators": list(engine.INTEGRATORS),
+        "integrators": list(engine.integrators.GENERAL),
         "force_evaluations_per_step": dict(engine.integrators.FORCE_EVALUATIONS),
     }
 
@@ -388,7 +388,7 @@ def measured_orders(sec, level):
     if not e or len(steps) < 2:
         return {}
     out = {}
-    for name in engine.INTEGRATORS:
+    for name in engine.integrators.GENERAL:
         if name == "rk45":
             continue
         errs = {}
@@ -623,7 +623,7 @@ def section_hard_cases(sec, fig_spring):
                                                  reverse=not steps_like)]
         extra = ["adaptive step"] if adaptive else []
         rows = []
-        order = list(engine.INTEGRATORS)
+        order = list(engine.integrators.GENERAL)
         for name in sorted(fixed, key=order.index):
             cells = fixed[name]
             rows.append([name] + [("—" if c not in cells else
@@ -671,7 +671,7 @@ def section_hard_cases(sec, fig_spring):
     out = sec["spring_outcomes"]
     ks_o = sorted({k for v in out.values() for k in v})
     rows = []
-    for name in engine.INTEGRATORS:
+    for name in engine.integrators.GENERAL:
         if name not in out:
             continue
         rows.append([name] + [f"**{out[name][k]['outcome']}**: {out[name][k]['detail']}"
@@ -791,7 +791,7 @@ def section_glance(res, level):
         if e:
             idx = min(1, len(e["checkpoints"]) - 1)
             cells = []
-            for name in engine.INTEGRATORS:
+            for name in engine.integrators.GENERAL:
                 key, val = ("tolerance", level.tb_tolerances[len(level.tb_tolerances) // 2]) \
                     if name == "rk45" else ("steps_per_orbit", n_mid)
                 err = _err_at(e, f"engine:{name}", key, val, idx)
@@ -839,7 +839,7 @@ def section_glance(res, level):
         cases = [c for c in ("e099", "pythagorean", "figure_eight", "flyby", "coincident")
                  if c in hc["tables"]]
         rows = []
-        for name in engine.INTEGRATORS:
+        for name in engine.integrators.GENERAL:
             cells = [name]
             for c in cases:
                 tab = hc["tables"][c]

@@ -217,7 +217,7 @@ def sweep_rebound(problem, integrator, ref, level):
 def timed_jobs(level):
     out = []
     for p in work_precision_set(level):
-        for name in engine.INTEGRATORS:
+        for name in engine.integrators.GENERAL:
             out.append(Job(("wp", p.key, "engine", name), "sweeps:sweep_engine",
                            dict(problem=p, integrator=name)))
         if p.rebound:
@@ -271,10 +271,10 @@ def assemble(level, references, sweeps):
                 run.update({"method": f"{code}:{name}", "code": code, "integrator": name,
                             "setting_label": setting_label(code, name, pt["setting"])})
                 runs.append(run)
-        order = list(engine.INTEGRATORS) + list(REBOUND_METHODS)
+        order = list(engine.integrators.GENERAL) + list(REBOUND_METHODS)
         runs.sort(key=lambda r: (r["code"] != "engine",
                                  order.index(r["integrator"]) if r["code"] == "engine"
-                                 else order.index(r["integrator"], len(engine.INTEGRATORS)),
+                                 else order.index(r["integrator"], len(engine.integrators.GENERAL)),
                                  r["steps"]))
         floor = ref["floor"] if metric(p) == "position" else 0.0
         section[p.key] = {

@@ -17,7 +17,7 @@ from .jobs import Job
 from .problems import make_sim, two_body_set
 from .reference import IAS15_REFERENCE_EPSILON, RebRun, kepler_states
 
-FIXED = tuple(name for name in engine.INTEGRATORS if name != "rk45")
+FIXED = tuple(name for name in engine.integrators.GENERAL if name != "rk45")
 REBOUND_FIXED = ("whfast", "leapfrog")
 
 
@@ -145,8 +145,8 @@ def assemble(level, results):
 
 
 def _run_order(run):
-    order = list(engine.INTEGRATORS) + ["whfast", "leapfrog"]
+    order = list(engine.integrators.GENERAL) + ["whfast", "leapfrog"]
     code_rank = 0 if run["code"] == "engine" else 1
     return (code_rank, order.index(run["integrator"]) if run["code"] == "engine"
-            else order.index(run["integrator"], len(engine.INTEGRATORS)),
+            else order.index(run["integrator"], len(engine.integrators.GENERAL)),
             run.get("steps_per_orbit", 0), -(run.get("tolerance") or 0))

@@ -60,7 +60,7 @@ def _alone(integrator, scene, m, box=None, dt=0.05, **kwargs):
     return sim
 
 
-@pytest.mark.parametrize("integrator", engine.INTEGRATORS)
+@pytest.mark.parametrize("integrator", engine.integrators.GENERAL)
 @pytest.mark.parametrize("box", [None, 1.0])
 def test_each_system_is_bit_identical_to_a_simulation_of_its_own(integrator, box):
     scene = _scene()
@@ -276,7 +276,7 @@ def test_potential_energies_of_many_terms_add_as_a_simulation_adds_them():
 
 def test_inactive_and_pinned_particles_stay_where_they_are_in_a_periodic_space():
     import engine as _engine
-    for integrator in _engine.INTEGRATORS:
+    for integrator in _engine.integrators.GENERAL:
         sim = Simulation(dim=2, integrator=integrator, dt=0.01, box=1.0)
         sim.add_many(mass=1.0, pos=[(0.7, 0.0), (0.2, 0.0), (0.0, 0.3)],
                      vel=[(0.0, 0.0), (1.0, 0.0), (0.5, 0.0)])

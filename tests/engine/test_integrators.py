@@ -173,7 +173,7 @@ def test_rk45_step_counts_accepted_steps_and_adapts_dt():
 def test_force_evaluations_table():
     assert engine.integrators.FORCE_EVALUATIONS == {
         "euler": 1, "symplectic_euler": 1, "leapfrog": 1, "verlet": 1, "rk4": 4,
-        "yoshida4": 3, "pefrl": 4, "rk45": 6}
+        "yoshida4": 3, "pefrl": 4, "rk45": 6, "whfast": 1}
 
 
 def test_verlet_equals_leapfrog_shifted_by_half_a_kick():

@@ -11,7 +11,7 @@ from engine import Simulation, SimulationError, forces, stability
 from engine.forces.dispatch import accelerations
 from engine.forces.pairwise import workspace
 
-FIXED_STEP = [name for name in engine.INTEGRATORS if name != "rk45"]
+FIXED_STEP = [name for name in engine.integrators.GENERAL if name != "rk45"]
 MEASURED = ["symplectic_euler", "leapfrog", "verlet", "yoshida4", "pefrl", "rk4"]
 G_EARTH = 9.8
 

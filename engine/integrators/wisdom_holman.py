@@ -1,0 +1,499 @@
+"""Wisdom-Holman splitting (``whfast``): Kepler drifts about the dominant body, interaction kicks.
+
+The Hamiltonian is split as H = H_Kepler + H_interaction, and a step is the symmetric
+composition drift(h/2) kick(h) drift(h/2), where the drift moves every body exactly on its own
+Kepler orbit (``engine.analytic.kepler_step``, universal variables, whole periods removed
+first) and the kick adds h times the acceleration of everything the Kepler part leaves out
+(Wisdom & Holman 1991, AJ 102, 1528; Rein & Tamayo 2015, MNRAS 452, 376). Inside one call the
+half drifts of consecutive steps are merged into one drift, so a step costs one force
+evaluation and one Kepler solve per body; the state is synchronised (the last half drift, the
+corrector's inverse, inertial coordinates) when the call ends.
+
+Two kinds of scene:
+
+``JACOBI`` (``NBodyGravity`` with a dominant mass)
+    Jacobi coordinates about the heaviest body, the others in index order, test particles last
+    (they feel gravity, exert none: they take no part in the interior masses). With interior
+    masses eta_j = sum_{k<=j} m_k, body j's Jacobi position r'_j = r_j - R_{j-1} (R the centre
+    of mass of the bodies before it) drifts on a Kepler orbit of mu_j = G eta_j, and the kick
+    is a'_j = (J a)_j + G eta_j r'_j / |r'_j|^3: the Jacobi transform of the inertial
+    accelerations of every declared term, plus the Kepler attraction the drift already took
+    (Wisdom & Holman 1991, eqs. 10-13; the transform of the accelerations is the transform of
+    the positions, since r' = J r is linear). The centre of mass drifts in a straight line.
+``ATTRACTOR`` (a fixed ``PointMass``)
+    every particle the attractor acts on drifts on its own Kepler orbit about it (mu and the
+    attractor's position from the term), the others in straight lines; the kick is the
+    acceleration of every other declared term. Exact for test particles about a fixed star:
+    the whole of Spacewar's star is in the drift.
+
+Kernels (``KERNEL_*``): the standard kick, and the lazy implementer's modified kick (Wisdom,
+Holman & Touma 1996, Fields Inst. Commun. 10, 217, sec. 4; Rein, Tamayo & Brown 2019, MNRAS
+489, 4632, sec. 2.3): the interaction evaluated at positions moved by h^2/12 times the
+interaction acceleration, which removes the h^3 error term {{A,B},B}.
+
+Symplectic correctors of order 3, 5, 7, 11 and 17 (Wisdom, Holman & Touma 1996; the order-17
+set from Rein, Tamayo & Brown 2019, table 1): the corrector C is applied when a call starts and
+its inverse when it ends, each a product of Z(a, b) = D(a) K(-b) D(-2a) K(b) D(a) operators,
+with a_k = k sqrt(7/40) h (coefficients as published in those papers).
+
+Other declared terms (drag, thrust, Coulomb, springs) enter through the kick; the method is
+then of second order in h for them (its high order in the mass ratio holds only for gravity).
+"""
+import math
+
+import numpy as np
+from numba import njit
+
+from ..analytic import kepler_step
+from ..forces.dispatch import accelerations
+from ..state import with_motion
+from ..space import wrap_scalar
+from .common import OK, all_finite
+
+NAME = "whfast"
+ORDER = 2
+
+JACOBI = 0
+ATTRACTOR = 1
+MODES = {"jacobi": JACOBI, "attractor": ATTRACTOR}
+
+KERNEL_STANDARD = 0
+KERNEL_LAZY = 1
+KERNELS = {"standard": KERNEL_STANDARD, "lazy": KERNEL_LAZY}
+
+_A1 = math.sqrt(7.0 / 40.0)  # 0.41833001326703777...
+# b coefficients of the correctors (Wisdom, Holman & Touma 1996; order 17: Rein, Tamayo &
+# Brown 2019), listed from the largest a multiple down to a_1
+_B = {
+    3: (-0.024900596027799867499350357910273437184309981229127,),
+    5: (-0.0083001986759332891664501193034244790614366604097090,
+        0.041500993379666445832250596517122395307183302048545),
+    7: (0.0024926811426922105779030593952776964450539008582219,
+        -0.018270923246702131478062356884535264841652263842597,
+        0.053964399093127498721765893493510877532452806339655),
+    11: (0.00020361579647854651301632818774633716473696537436847,
+         -0.0023487215292295354188307328851055489876255097419754,
+         0.012309078592019946317544564763237909911330686448336,
+         -0.038121613681288650508647613260247372125243616270670,
+         0.072593394748842738674253180742744961827622366521517),
+    17: (-0.0000043347415473373580190650223498124944896789841432241,
+         0.000076436355227935738363241846979413475106795392377415,
+         -0.00063599983075817658983166881625078545864140848560259,
+         0.0033132577069380655655490196833451994080066801611459,
+         -0.012071760822342291062449751726959664253913904872527,
+         0.032422198864713580293681523029577130832258806467604,
+         -0.065192863576377893658290760803725762027864651086787,
+         0.093056103771425958591541059067553547100903397724386),
+}
+#: the corrector orders one can ask for (0: none)
+CORRECTORS = (0,) + tuple(sorted(_B))
+
+
+def corrector_table(order):
+    """The corrector of ``order`` as rows (a / h, b / h) of its Z operators, in the order they
+    are applied (the inverse applies the same rows with b negated). Order 3 is the pair
+    Z(a1, -b), Z(-a1, b); the higher orders are Z(-a_k, -b_k) for k from the largest down,
+    then Z(a_k, b_k) back up (Wisdom, Holman & Touma 1996, sec. 5)."""
+    if order == 0:
+        return np.zeros((0, 2))
+    bs = _B[order]
+    if order == 3:
+        return np.array([[_A1, -bs[0]], [-_A1, bs[0]]])
+    m = len(bs)
+    rows = [[-(m - k) * _A1, -bs[k]] for k in range(m)]
+    rows += [[(m - k) * _A1, bs[k]] for k in reversed(range(m))]
+    return np.array(rows)
+
+
+# -- coordinates ------------------------------------------------------------------------------
+@njit(cache=True, error_model="numpy")
+def _to_jacobi(pos, vel, m, order, count, jp, jv, eta):
+    """Jacobi positions and velocities of the bodies ``order[:count]`` (the first is the
+    centre) into ``jp``, ``jv`` (column j for order[j]; column 0 the centre of mass), and the
+    interior masses eta_j."""
+    dim = pos.shape[0]
+    c = order[0]
+    e = m[c]
+    eta[0] = e
+    for k in range(dim):
+        jp[k, 0] = m[c] * pos[k, c]  # running mass-weighted sums
+        jv[k, 0] = m[c] * vel[k, c]
+    for j in range(1, count):
+        i = order[j]
+        for k in range(dim):
+            sx = jp[k, 0]
+            sv = jv[k, 0]
+            jp[k, j] = pos[k, i] - sx / e
+            jv[k, j] = vel[k, i] - sv / e
+            jp[k, 0] = sx + m[i] * pos[k, i]
+            jv[k, 0] = sv + m[i] * vel[k, i]
+        e += m[i]
+        eta[j] = e
+    for k in range(dim):
+        jp[k, 0] /= e
+        jv[k, 0] /= e
+
+
+@njit(cache=True, error_model="numpy")
+def _from_jacobi(jp, jv, m, order, count, eta, pos, vel, with_vel):
+    """Inertial positions (and velocities) from Jacobi ones (the inverse of ``_to_jacobi``):
+    with S_j the mass-weighted sum of the first j + 1 bodies, S_{j-1} = (S_j - m r'_j)
+    eta_{j-1} / eta_j and r = r'_j + S_{j-1} / eta_{j-1}."""
+    dim = jp.shape[0]
+    for k in range(dim):
+        s = jp[k, 0] * eta[count - 1]
+        sv = jv[k, 0] * eta[count - 1]
+        for j in range(count - 1, 0, -1):
+            i = order[j]
+            s = (s - m[i] * jp[k, j]) / eta[j]
+            pos[k, i] = jp[k, j] + s
+            s *= eta[j - 1]
+            if with_vel:
+                sv = (sv - m[i] * jv[k, j]) / eta[j]
+                vel[k, i] = jv[k, j] + sv
+                sv *= eta[j - 1]
+        c = order[0]
+        pos[k, c] = s / m[c]
+        if with_vel:
+            vel[k, c] = sv / m[c]
+
+
+@njit(cache=True, error_model="numpy")
+def _jacobi_accelerations(acc, m, order, count, eta, ja):
+    """The Jacobi transform of inertial accelerations (the same map as the positions')."""
+    dim = acc.shape[0]
+    c = order[0]
+    for k in range(dim):
+        s = m[c] * acc[k, c]
+        for j in range(1, count):
+            i = order[j]
+            ja[k, j] = acc[k, i] - s / eta[j - 1]
+            s += m[i] * acc[k, i]
+        ja[k, 0] = s / eta[count - 1]
+
+
+# -- the two operators ------------------------------------------------------------------------
+@njit(cache=True, error_model="numpy")
+def _kepler_drift(mode, jp, jv, mu, count, h, r, v, box):
+    """Every moving body along its Kepler orbit for time h (mu[j] = 0: a straight line);
+    in JACOBI mode column 0, the centre of mass, always moves in a straight line. In a
+    periodic space (ATTRACTOR mode only) each position relative to the attractor is taken
+    back to its nearest image afterwards, the image the attractor's force acts from."""
+    dim = jp.shape[0]
+    first = 1 if mode == JACOBI else 0
+    if mode == JACOBI:
+        for k in range(dim):
+            jp[k, 0] += h * jv[k, 0]
+    for j in range(first, count):
+        if mu[j] > 0.0:
+            for k in range(dim):
+                r[k] = jp[k, j]
+                v[k] = jv[k, j]
+            kepler_step(r, v, mu[j], h, r, v)
+            for k in range(dim):
+                jp[k, j] = r[k]
+                jv[k, j] = v[k]
+        else:
+            for k in range(dim):
+                jp[k, j] += h * jv[k, j]
+        if box > 0.0:
+            for k in range(dim):
+                jp[k, j] = wrap_scalar(jp[k, j], box)
+
+
+@njit(cache=True, error_model="numpy")
+def _interaction(mode, t, jp, state, kick_model, work, m, order, count, eta, mu, center, acc,
+                 ja, kick_com):
+    """The acceleration of the interaction part at the current positions, per coordinate
+    column, into ``ja``: ATTRACTOR mode, every other term's acceleration; JACOBI mode, the
+    Jacobi transform of every term's plus G eta_j r'_j / |r'_j|^3 (the Kepler part's own
+    attraction, taken out). ``state.pos`` must hold the inertial positions."""
+    accelerations(t, state, kick_model, acc, work)
+    dim = jp.shape[0]
+    if mode == ATTRACTOR:
+        for j in range(count):
+            i = order[j]
+            for k in range(dim):
+                ja[k, j] = acc[k, i]
+        return
+    _jacobi_accelerations(acc, m, order, count, eta, ja)
+    if not kick_com:
+        for k in range(dim):
+            ja[k, 0] = 0.0
+    for j in range(1, count):
+        if mu[j] > 0.0:
+            r2 = 0.0
+            for k in range(dim):
+                r2 += jp[k, j] * jp[k, j]
+            s = mu[j] / (r2 * math.sqrt(r2))
+            for k in range(dim):
+                ja[k, j] += s * jp[k, j]
+
+
+@njit(cache=True, error_model="numpy")
+def _sync_positions(mode, jp, jv, m, order, count, eta, center, pos, vel, with_vel, box):
+    """Inertial positions (and velocities) in ``pos``, ``vel`` from the coordinates."""
+    dim = jp.shape[0]
+    if mode == JACOBI:
+        _from_jacobi(jp, jv, m, order, count, eta, pos, vel, with_vel)
+        return
+    for j in range(count):
+        i = order[j]
+        for k in range(dim):
+            pos[k, i] = wrap_scalar(jp[k, j] + center[k], box)
+            if with_vel:
+                vel[k, i] = jv[k, j]
+
+
+@njit(cache=True, error_model="numpy")
+def _kick(mode, t, h, jp, jv, state, kick_model, work, m, order, count, eta, mu, center, acc,
+          ja, kick_com, kernel, shifted, vdep):
+    """v' += h a'_interaction; the lazy kernel evaluates a' at positions moved by
+    h^2/12 a' first. With velocity-dependent terms the acceleration is taken at the
+    velocities half way through the kick (explicit midpoint; the lazy kernel then does not
+    apply)."""
+    dim = jp.shape[0]
+    pos = state.pos
+    vel = state.vel
+    _sync_positions(mode, jp, jv, m, order, count, eta, center, pos, vel, vdep, state.box)
+    _interaction(mode, t, jp, state, kick_model, work, m, order, count, eta, mu, center, acc,
+                 ja, kick_com)
+    if vdep:
+        # a velocity-dependent term: the kick's acceleration taken at the velocity half way
+        # through it (the explicit midpoint rule), so that the kick stays second order
+        for j in range(count):
+            for k in range(dim):
+                shifted[k, j] = jv[k, j] + 0.5 * h * ja[k, j]
+        _sync_positions(mode, jp, shifted, m, order, count, eta, center, pos, vel, True,
+                        state.box)
+        _interaction(mode, t, jp, state, kick_model, work, m, order, count, eta, mu, center,
+                     acc, ja, kick_com)
+    elif kernel == KERNEL_LAZY:
+        eps = h * h / 12.0
+        first = 1 if mode == JACOBI else 0
+        for j in range(count):
+            for k in range(dim):
+                shifted[k, j] = jp[k, j] + (eps * ja[k, j] if j >= first else 0.0)
+        _sync_positions(mode, shifted, jv, m, order, count, eta, center, pos, vel, False,
+                        state.box)
+        _interaction(mode, t, shifted, state, kick_model, work, m, order, count, eta, mu,
+                     center, acc, ja, kick_com)
+    for j in range(count):
+        for k in range(dim):
+            jv[k, j] += h * ja[k, j]
+
+
+@njit(cache=True, error_model="numpy")
+def _corrector(table, sign, h, mode, t, jp, jv, state, kick_model, work, m, order, count, eta,
+               mu, center, acc, ja, kick_com, r, v, shifted, vdep):
+    """The corrector (sign 1) or its inverse (sign -1): Z(a, b) = D(a) K(-b) D(-2a) K(b) D(a)
+    for each row (a / h, b / h) of ``table``."""
+    for row in range(table.shape[0]):
+        a = table[row, 0] * h
+        b = sign * table[row, 1] * h
+        _kepler_drift(mode, jp, jv, mu, count, a, r, v, state.box)
+        _kick(mode, t, -b, jp, jv, state, kick_model, work, m, order, count, eta, mu, center,
+              acc, ja, kick_com, KERNEL_STANDARD, shifted, vdep)
+        _kepler_drift(mode, jp, jv, mu, count, -2.0 * a, r, v, state.box)
+        _kick(mode, t, b, jp, jv, state, kick_model, work, m, order, count, eta, mu, center,
+              acc, ja, kick_com, KERNEL_STANDARD, shifted, vdep)
+        _kepler_drift(mode, jp, jv, mu, count, a, r, v, state.box)
+
+
+@njit(cache=True, error_model="numpy")
+def _first_bad_column(jp, jv, count):
+    for j in range(count):
+        for k in range(jp.shape[0]):
+            if not (math.isfinite(jp[k, j]) and math.isfinite(jv[k, j])):
+                return j
+    return 0
+
+
+@njit(cache=True, error_model="numpy")
+def _coordinates(mode, pos, vel, m, order, count, center, jp, jv, eta, box):
+    dim = pos.shape[0]
+    if mode == JACOBI:
+        _to_jacobi(pos, vel, m, order, count, jp, jv, eta)
+        return
+    for j in range(count):
+        i = order[j]
+        for k in range(dim):
+            jp[k, j] = wrap_scalar(pos[k, i] - center[k], box)
+            jv[k, j] = vel[k, i]
+
+
+@njit(cache=True, error_model="numpy")
+def kepler_parameters(mode, m, order, count, eta, G, mu_attractor, attracted, mu):
+    """mu per coordinate column: G eta_j in JACOBI mode (0 for the centre of mass), the
+    attractor's mu for the particles it acts on in ATTRACTOR mode (else 0)."""
+    for j in range(count):
+        if mode == JACOBI:
+            mu[j] = 0.0 if j == 0 else G * eta[j]
+        else:
+            mu[j] = mu_attractor if attracted[order[j]] else 0.0
+
+
+@njit(cache=True, error_model="numpy")
+def advance(t, h, steps, state, kick_model, work, vdep, t_end, mode, order, m, G, mu_attractor,
+            center, attracted, kick_com, kernel, corrector):
+    """``steps`` Wisdom-Holman steps of ``h`` (see the module). ``order`` lists the particles
+    that move, the centre first in JACOBI mode; ``m`` the masses the coordinates use (test
+    particles 0); ``attracted[i]`` whether the attractor acts on particle i (ATTRACTOR mode);
+    ``corrector`` the table of ``corrector_table``. Returns ``(t, h, done, status)`` as every
+    integrator does; on a non-finite state the last finite one is restored, synchronised."""
+    pos = state.pos
+    vel = state.vel
+    dim = pos.shape[0]
+    count = order.shape[0]
+    jp = np.empty((dim, count))
+    jv = np.empty((dim, count))
+    save_p = np.empty((dim, count))
+    save_v = np.empty((dim, count))
+    shifted = np.empty((dim, count))
+    ja = np.empty((dim, count))
+    eta = np.empty(count)
+    mu = np.empty(count)
+    acc = np.empty((dim, state.n))
+    r = np.empty(dim)
+    v = np.empty(dim)
+    if count == 0 or steps == 0:
+        return t, h, 0, OK
+    t0 = t
+    first_p = pos.copy()  # the call's starting state: kept bit for bit if its first step fails
+    first_v = vel.copy()
+    _coordinates(mode, pos, vel, m, order, count, center, jp, jv, eta, state.box)
+    kepler_parameters(mode, m, order, count, eta, G, mu_attractor, attracted, mu)
+    _corrector(corrector, 1.0, h, mode, t, jp, jv, state, kick_model, work, m, order, count,
+               eta, mu, center, acc, ja, kick_com, r, v, shifted, vdep)
+    _kepler_drift(mode, jp, jv, mu, count, 0.5 * h, r, v, state.box)
+    done = 0
+    status = OK
+    for step in range(steps):
+        if not all_finite(jp, jv, count):
+            status = order[_first_bad_column(jp, jv, count)]
+            break
+        save_p[:, :] = jp
+        save_v[:, :] = jv
+        _kick(mode, t + 0.5 * h, h, jp, jv, state, kick_model, work, m, order, count, eta, mu,
+              center, acc, ja, kick_com, kernel, shifted, vdep)
+        _kepler_drift(mode, jp, jv, mu, count, h if step < steps - 1 else 0.5 * h, r, v,
+                      state.box)
+        if not all_finite(jp, jv, count):
+            status = order[_first_bad_column(jp, jv, count)]
+            break
+        t = t + h
+        done += 1
+    if status == OK:
+        _corrector(corrector, -1.0, h, mode, t, jp, jv, state, kick_model, work, m, order,
+                   count, eta, mu, center, acc, ja, kick_com, r, v, shifted, vdep)
+        _sync_positions(mode, jp, jv, m, order, count, eta, center, pos, vel, True, state.box)
+        if all_finite(pos, vel, state.n):
+            return t, h, done, OK
+        status = order[0]
+        done -= 1  # the inverse corrector failed: back to the last step's start
+        t = t - h
+    if done > 0:
+        # the last finite state: the step that failed began half a drift after it
+        jp[:, :] = save_p
+        jv[:, :] = save_v
+        _kepler_drift(mode, jp, jv, mu, count, -0.5 * h, r, v, state.box)
+        _corrector(corrector, -1.0, h, mode, t, jp, jv, state, kick_model, work, m, order,
+                   count, eta, mu, center, acc, ja, kick_com, r, v, shifted, vdep)
+        _sync_positions(mode, jp, jv, m, order, count, eta, center, pos, vel, True, state.box)
+        if all_finite(pos, vel, state.n):
+            return t, h, done, status
+    pos[:, :] = first_p  # nothing finite to stop at after the start: the start, unchanged
+    vel[:, :] = first_v
+    return t0, h, 0, status
+
+
+# -- the plan: which bodies, which coordinates (Python, once per call) ---------------------------
+#: JACOBI mode needs the heaviest body to carry at least this many times the rest's mass
+#: (more than two massive bodies; with two, the Kepler drift is the whole motion)
+DOMINANCE = 10.0
+
+
+class Plan:
+    """What ``advance`` needs beyond the state: built by ``plan`` from a simulation's terms."""
+
+    def __init__(self, mode, order, masses, G, mu, center, attracted, kick_model, kick_com):
+        self.mode, self.order, self.masses, self.G = mode, order, masses, G
+        self.mu, self.center, self.attracted = mu, center, attracted
+        self.kick_model, self.kick_com = kick_model, kick_com
+
+    def arguments(self):
+        return (self.mode, self.order, self.masses, self.G, self.mu, self.center,
+                self.attracted)
+
+
+def plan(terms, state, model, pack_terms):
+    """The Wisdom-Holman plan for a scene, or ValueError naming why it has none.
+
+    ``terms`` are the declared force terms (in model order), ``pack_terms(list)`` packs a
+    subset into a ``Model``. A single ``PointMass`` (without softening) makes ATTRACTOR mode;
+    otherwise a single ``NBodyGravity`` (without softening, in open space) whose heaviest body
+    dominates (``DOMINANCE``) makes JACOBI mode."""
+    from ..forces import NBodyGravity, PointMass
+
+    n = state.n
+    active = np.asarray(state.active[:n])
+    pinned = np.asarray(state.pinned[:n])
+    test = np.asarray(state.test[:n])
+    moving = np.flatnonzero(active & ~pinned)
+    attractors = [s for s, term in enumerate(terms) if isinstance(term, PointMass)]
+    gravities = [s for s, term in enumerate(terms) if isinstance(term, NBodyGravity)]
+    dim = state.pos.shape[0]
+    if len(attractors) > 1:
+        raise ValueError(f"whfast drifts about one attractor; this scene declares "
+                         f"{len(attractors)} PointMass terms")
+    if attractors:
+        s = attractors[0]
+        f0 = model.param_offsets[s]
+        mu, eps2 = float(model.params[f0]), float(model.params[f0 + 1])
+        if eps2 != 0.0:
+            raise ValueError(f"whfast drifts on exact Kepler orbits about the PointMass: its "
+                             f"softening must be 0, got {eps2 ** 0.5!r}")
+        center = np.array(model.params[f0 + 2:f0 + 2 + dim], dtype=np.float64)
+        i0, i1 = model.index_offsets[s], model.index_offsets[s + 1]
+        attracted = np.zeros(max(n, 1), dtype=np.bool_)
+        if i1 == i0:
+            attracted[:n] = True
+        else:
+            attracted[model.indices[i0:i1]] = True
+        others = [term for k, term in enumerate(terms) if k != s]
+        return Plan(ATTRACTOR, moving.astype(np.int64), np.zeros(1), 0.0, mu, center,
+                    attracted, pack_terms(others), True)
+    if len(gravities) != 1:
+        raise ValueError("whfast needs a dominant mass to drift about: declare a PointMass "
+                         "attractor, or NBodyGravity with one body much heavier than the rest"
+                         + (f"; this scene declares {len(gravities)} NBodyGravity terms"
+                            if gravities else "; this scene declares neither"))
+    s = gravities[0]
+    f0 = model.param_offsets[s]
+    G, eps2 = float(model.params[f0]), float(model.params[f0 + 1])
+    if eps2 != 0.0:
+        raise ValueError(f"whfast drifts on exact Kepler orbits: NBodyGravity's softening must "
+                         f"be 0, got {eps2 ** 0.5!r}")
+    if state.box > 0.0:
+        raise ValueError(f"whfast in Jacobi coordinates needs open space, got box={state.box!r} "
+                         "(a PointMass attractor may sit in a periodic space)")
+    if (active & pinned).any():
+        i = int(np.flatnonzero(active & pinned)[0])
+        raise ValueError(f"whfast in Jacobi coordinates moves every body: particle {i} is "
+                         "pinned (make a fixed central body a PointMass attractor instead)")
+    masses = np.where(test, 0.0, np.asarray(state.mass[:n], dtype=np.float64))
+    massive = [int(i) for i in moving if masses[i] > 0.0]
+    if not massive:
+        raise ValueError("whfast needs a dominant mass to drift about: no active body has mass")
+    heaviest = max(massive, key=lambda i: (masses[i], -i))
+    rest = float(sum(masses[i] for i in massive)) - masses[heaviest]
+    if len(massive) > 2 and masses[heaviest] < DOMINANCE * rest:
+        raise ValueError(f"whfast needs a dominant mass: the heaviest body (particle {heaviest}, "
+                         f"mass {float(masses[heaviest])!r}) carries less than {DOMINANCE:g} times "
+                         f"the other bodies' {float(rest)!r}; use a method for any scene "
+                         "(engine.integrators.GENERAL) instead")
+    order = [heaviest] + [i for i in massive if i != heaviest]
+    order += [int(i) for i in moving if masses[i] == 0.0]
+    kick_com = any(not isinstance(term, NBodyGravity) for term in terms)
+    return Plan(JACOBI, np.array(order, dtype=np.int64), masses, G, 0.0, np.zeros(dim),
+                np.zeros(1, dtype=np.bool_), model, kick_com)
