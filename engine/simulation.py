@@ -14,6 +14,8 @@ from ._validate import MAX_STEPS, finite_float, nonnegative_float, positive_floa
 from .errors import SimulationError
 from .forces.base import DeclaresTerms
 from .forces.dispatch import pack, potential_terms
+from .integrators import ias15 as _ias15
+from .integrators import janus as _janus
 from .integrators import wisdom_holman
 from .particles import Particles
 from .space import check_box
@@ -33,8 +35,10 @@ class Simulation(DeclaresTerms):
     ----------
     dim : 2 or 3
     integrator : one of ``engine.INTEGRATORS``
-    dt : the (signed, non-zero) step; for ``rk45`` the first step, then adapted
-    tolerance : error tolerance of ``rk45`` (relative and absolute), > 0
+    dt : the (signed, non-zero) step; for the adaptive ``rk45`` and ``ias15`` the first step,
+        then adapted
+    tolerance : error tolerance of ``rk45`` (relative and absolute), and ``ias15``'s epsilon
+        (its step criterion's precision parameter; 1e-9 is REBOUND's default), > 0
     units : ``None`` (code units, G = 1) or three astropy units of length, time and mass
     G : override the gravitational constant (default 1, or astropy's G in ``units``)
     capacity : initial room for particles (an int in [0, 2**31]; grows as needed)
@@ -45,6 +49,10 @@ class Simulation(DeclaresTerms):
         ``engine.integrators.wisdom_holman.CORRECTORS`` (0: none; 3, 5, 7, 11, 17)
     kernel : ``whfast``'s kernel, ``"standard"`` or ``"lazy"`` (the lazy implementer's
         modified kick, one more force evaluation per step)
+    saba : the ``saba`` integrator's method: ``"SABA1"`` to ``"SABA4"``, ``"SABAC1"`` to
+        ``"SABAC4"`` (with the lazy corrector), ``"SABA(10,4)"``, ``"SABA(8,6,4)"``,
+        ``"SABA(10,6,4)"`` (the default)
+    janus_order : ``janus``'s order, 2, 4, 6 (the default) or 8
 
     ``pos``, ``vel``, ``mass``, ``charge`` and ``radius`` are writable views of the state. A
     step first checks them: a non-finite value written there (or a negative mass or radius)
@@ -53,11 +61,16 @@ class Simulation(DeclaresTerms):
     """
 
     def __init__(self, dim=2, integrator="symplectic_euler", dt=1.0, tolerance=1e-9,
-                 units=None, G=None, capacity=16, box=None, corrector=0, kernel="standard"):
+                 units=None, G=None, capacity=16, box=None, corrector=0, kernel="standard",
+                 saba=wisdom_holman.DEFAULT_SABA, janus_order=6):
         if isinstance(dim, bool) or dim not in (2, 3):
             raise ValueError(f"dim must be 2 or 3, got {dim!r}")
         self._corrector = _check_corrector(corrector)
         self._kernel = _check_kernel(kernel)
+        self._saba = _check_saba(saba)
+        self._janus_order = _check_janus_order(janus_order)
+        self._ias15_memory = None  # the predictor's coefficients, kept between calls
+        self._janus_lattice = None  # (kx, kv), chosen at the first janus step
         self._units = None if units is None else UnitSystem(units)
         self._integrator = _integrators.check_name(integrator)
         self._dt = self._check_dt(dt)
@@ -122,6 +135,48 @@ class Simulation(DeclaresTerms):
     @kernel.setter
     def kernel(self, value):
         self._kernel = _check_kernel(value)
+
+    @property
+    def janus_order(self):
+        """``janus``'s order (2, 4, 6 or 8)."""
+        return self._janus_order
+
+    @janus_order.setter
+    def janus_order(self, value):
+        self._janus_order = _check_janus_order(value)
+
+    @property
+    def janus_lattice(self):
+        """``janus``'s lattice exponents ``(kx, kv)``: positions are whole multiples of
+        2**-kx and velocities of 2**-kv (None until the first janus step chooses them with
+        ``engine.integrators.janus.lattice_exponents``; they are then kept, so that a run
+        with ``-dt`` retraces it bit for bit). Set them, or set None to choose again."""
+        return self._janus_lattice
+
+    @janus_lattice.setter
+    def janus_lattice(self, value):
+        if value is None:
+            self._janus_lattice = None
+            return
+        try:
+            kx, kv = value
+        except (TypeError, ValueError):
+            raise ValueError(f"janus_lattice must be None or two ints (kx, kv), got {value!r}")
+        for name, k in (("kx", kx), ("kv", kv)):
+            if isinstance(k, bool) or not isinstance(k, numbers.Integral) or \
+                    abs(k) > _janus.MAX_EXPONENT:
+                raise ValueError(f"janus_lattice {name} must be an int in "
+                                 f"[-{_janus.MAX_EXPONENT}, {_janus.MAX_EXPONENT}], got {k!r}")
+        self._janus_lattice = (int(kx), int(kv))
+
+    @property
+    def saba(self):
+        """The ``saba`` integrator's method (``engine.integrators.wisdom_holman.SABA_METHODS``)."""
+        return self._saba
+
+    @saba.setter
+    def saba(self, value):
+        self._saba = _check_saba(value)
 
     @property
     def tolerance(self):
@@ -357,11 +412,12 @@ class Simulation(DeclaresTerms):
                              "overflows a float")
         h = math.copysign(abs(self._dt), remaining)
         needed = abs(remaining) / abs(h)
-        if self._integrator != "rk45" and not needed <= _MAX_STEPS:
+        adaptive = self._integrator in _integrators.ADAPTIVE_INTEGRATORS
+        if not adaptive and not needed <= _MAX_STEPS:
             raise ValueError(f"t_end={t_end!r} needs {needed:.3g} steps of dt={self._dt!r} from "
                              f"t={self._t!r}, more than the 2**62 one call can take; use a "
                              "larger dt or a nearer t_end")
-        if self._integrator == "rk45":
+        if adaptive:
             self._run(h, _MAX_STEPS, t_end)
             return
         t0 = self._t
@@ -376,7 +432,8 @@ class Simulation(DeclaresTerms):
         self._t = t_end
 
     def _run(self, h, steps, t_end, keep_dt=False):
-        if self._integrator != "rk45" and not math.isfinite(self._t + steps * h):
+        adaptive = self._integrator in _integrators.ADAPTIVE_INTEGRATORS
+        if not adaptive and not math.isfinite(self._t + steps * h):
             raise ValueError(f"{steps} steps of {h!r} from t={self._t!r} take the time past the "
                              "largest float (t would not be finite); nothing was changed")
         state, model = self.kernel_arguments()
@@ -384,15 +441,18 @@ class Simulation(DeclaresTerms):
         plan = None
         if self._integrator in _integrators.KEPLER_SPLITTING:
             plan = wisdom_holman.plan(self._forces, state, model,
-                                      lambda terms: pack(terms, self))
+                                      lambda terms: pack(terms, self), self._integrator)
         vdep = any(f.velocity_dependent for f in self._forces)
+        memory = self._ias15_state(state) if self._integrator == "ias15" else None
+        lattice = self._janus_exponents(state) if self._integrator == "janus" else None
         t, h_next, done, status = _integrators.advance(
             self._integrator, self._t, h, steps, state, model, vdep, t_end, self._tolerance,
-            plan=plan, corrector=self._corrector, kernel=self._kernel)
+            plan=plan, corrector=self._corrector, kernel=self._kernel, saba=self._saba,
+            memory=memory, janus_order=self._janus_order, lattice=lattice)
         failed_step = self.steps + done
         self._t = t
         self.steps += done
-        if (self._integrator == "rk45" and not keep_dt and status < 0
+        if (adaptive and not keep_dt and status < 0
                 and status != _integrators.common.TIME_OVERFLOW):
             self._dt = h_next
         if status >= 0:
@@ -401,16 +461,43 @@ class Simulation(DeclaresTerms):
                 "non-finite position or velocity (singular force, or dt too large for a stiff "
                 "force); the last finite state is kept",
                 step=failed_step, time=t, particle=int(status))
+        if status == _janus.LATTICE_OVERFLOW:
+            raise SimulationError(
+                f"janus step {failed_step} from t={t!r} would take a position or velocity off its "
+                f"lattice (|value| >= 2**53 lattice units of janus_lattice={lattice!r}): a close "
+                "encounter or an escape; the state before that step is kept (set "
+                "sim.janus_lattice = None to choose coarser spacings)",
+                step=failed_step, time=t, particle=None)
+        if status == _janus.BAD_LATTICE:
+            raise ValueError(f"janus_lattice={lattice!r} does not fit this simulation (exponents "
+                             f"out of range, or box={self._box!r} not a whole number of lattice "
+                             "units); nothing was changed")
         if status == _integrators.common.TIME_OVERFLOW:
             raise SimulationError(
-                f"rk45 step {failed_step} from t={t!r} with step {h_next!r} would take the time "
+                f"{self._integrator} step {failed_step} from t={t!r} with step {h_next!r} would take the time "
                 "past the largest float (t would not be finite); the last finite state is kept",
                 step=failed_step, time=t, particle=None)
         if status == _integrators.common.STEP_COLLAPSED:
             raise SimulationError(
-                f"rk45 step size collapsed at step {failed_step}, t={t!r} (tolerance "
+                f"{self._integrator} step size collapsed at step {failed_step}, t={t!r} (tolerance "
                 f"{self._tolerance!r} cannot be met); the last accepted state is kept",
                 step=failed_step, time=t, particle=None)
+
+    def _ias15_state(self, state):
+        """IAS15's memory between calls (its predictor's coefficients): kept while the
+        particle count stays; IAS15 itself starts cold when the positions or velocities were
+        written since its last call."""
+        shape = _ias15.memory_shape(self.dim, state.n)
+        if self._ias15_memory is None or self._ias15_memory.shape != shape:
+            self._ias15_memory = _ias15.new_memory(self.dim, state.n)
+        return self._ias15_memory
+
+    def _janus_exponents(self, state):
+        if self._janus_lattice is None:
+            self._janus_lattice = _janus.lattice_exponents(
+                state.pos, state.vel, state.n, box=state.box, active=state.active,
+                pinned=state.pinned)
+        return self._janus_lattice
 
     def _check_state(self, state):
         """Refuse to step from a state the user made invalid by writing the arrays directly.
@@ -531,3 +618,16 @@ def _check_kernel(value):
         raise ValueError(f"kernel must be one of {', '.join(map(repr, wisdom_holman.KERNELS))}, "
                          f"got {value!r}")
     return value
+
+
+def _check_saba(value):
+    if value not in wisdom_holman.SABA_METHODS:
+        raise ValueError(f"saba must be one of {', '.join(wisdom_holman.SABA_METHODS)}, got "
+                         f"{value!r}")
+    return value
+
+
+def _check_janus_order(value):
+    if isinstance(value, bool) or value not in _janus.ORDERS:
+        raise ValueError(f"janus_order must be one of {_janus.ORDERS}, got {value!r}")
+    return int(value)

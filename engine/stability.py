@@ -87,6 +87,8 @@ from .forces import springs as _springs
 from .forces._kernels import pair_box
 from .integrators import INTEGRATORS, check_name
 from .integrators.dormand_prince import _A as _DP_A
+from .integrators import janus as _janus
+from .integrators import wisdom_holman
 from .integrators.splitting import SCHEMES
 from .space import wrap_scalar
 
@@ -121,12 +123,11 @@ def amplification_matrix(integrator, z):
     (x, v / omega): ``[x, v/omega]_{n+1} = G(z) [x, v/omega]_n``. ``z`` may be an array (the
     matrices are then stacked on the last two axes)."""
     check_name(integrator)
-    # whfast's kick of a perturbation is leapfrog's (drift-kick-drift) on that perturbation
-    integrator = _SAME_LIMIT.get(integrator, integrator)
     z = np.asarray(z, dtype=np.float64)
     one, zero = np.ones_like(z), np.zeros_like(z)
-    if integrator in SCHEMES:
-        drifts, kicks, _ = SCHEMES[integrator]
+    if integrator in SCHEMES or integrator in _KEPLER_TABLES:
+        drifts, kicks = (SCHEMES[integrator][:2] if integrator in SCHEMES
+                         else _KEPLER_TABLES[integrator])
         g = [[one, zero], [zero, one]]
         for c, d in zip(drifts, kicks):
             # drift x += c h v, i.e. x += c z (v / omega); then kick v / omega -= d z x
@@ -150,14 +151,31 @@ def amplification_matrix(integrator, z):
     return eye + sum(b[s] * stages[s] for s in range(len(b)))
 
 
-#: integrators whose step limit on an oscillator in their kick is another's
-_SAME_LIMIT = {"whfast": "leapfrog"}
+def _kepler_table(drifts, kicks):
+    """A Kepler-drift splitting as (drift, kick) stages: on a scene without a Kepler part its
+    drifts are straight lines, and it is this splitting scheme."""
+    return tuple(drifts), tuple(kicks) + (0.0,)
+
+
+#: whfast and saba (its default method) as splitting schemes, for their limits on an
+#: oscillator in the kick
+def _leapfrog_composition(gammas):
+    """Drift-kick-drift leapfrogs of steps g_i h in a row, the adjacent half drifts merged."""
+    drifts = [0.5 * gammas[0]] + [0.5 * (a + b) for a, b in zip(gammas[:-1], gammas[1:])]
+    return tuple(drifts) + (0.5 * gammas[-1],), tuple(gammas) + (0.0,)
+
+
+_KEPLER_TABLES = {"whfast": _kepler_table(*wisdom_holman.WH),
+                  "saba": _kepler_table(*wisdom_holman.saba_scheme(wisdom_holman.DEFAULT_SABA)[:2]),
+                  # janus off its lattice (the default order 6)
+                  "janus": _leapfrog_composition(list(_janus.stage_coefficients(6)))}
+#: adaptive methods without a fixed-step limit of their own here
+_NO_LIMIT = ("ias15",)
 
 
 def _stable(integrator, z, slack=0.0):
     g = amplification_matrix(integrator, z)
-    integrator = _SAME_LIMIT.get(integrator, integrator)
-    if integrator in SCHEMES:
+    if integrator in SCHEMES or integrator in _KEPLER_TABLES:
         # det G = 1 (symplectic): stable while both eigenvalues stay on the unit circle
         return np.abs(g[..., 0, 0] + g[..., 1, 1]) <= 2.0 + slack
     return np.abs(np.linalg.eigvals(g)).max(axis=-1) <= 1.0 + slack
@@ -168,6 +186,8 @@ def step_limit(integrator):
     """z_max = (omega h)_max of ``integrator`` on an undamped oscillator (see the module):
     the first z where its amplification matrix stops being stable; 0.0 for ``euler``."""
     check_name(integrator)
+    if integrator in _NO_LIMIT:
+        raise ValueError(f"{integrator} adapts its own step: it has no fixed-step limit")
     if integrator == "euler":
         return 0.0
     grid = np.arange(1, 10001) * 1e-3  # z in (0, 10]: every limit lies below 3.5
@@ -188,8 +208,9 @@ def step_limit(integrator):
 
 
 def step_limits():
-    """``{integrator: z_max}`` for every integrator of ``engine.INTEGRATORS``."""
-    return {name: step_limit(name) for name in INTEGRATORS}
+    """``{integrator: z_max}`` for every integrator of ``engine.INTEGRATORS`` but ``ias15``
+    (which adapts its step with no fixed-step limit)."""
+    return {name: step_limit(name) for name in INTEGRATORS if name not in _NO_LIMIT}
 
 
 # -- the spring network ------------------------------------------------------------------------
@@ -513,6 +534,9 @@ def stable_dt(sim, integrator=None):
     stable (``euler`` on any oscillation, a massless particle on a spring, coincident bodies
     without softening). ``rk45`` is refused (ValueError): it adapts its own step."""
     name = check_name(sim.integrator if integrator is None else integrator)
+    if name in _NO_LIMIT:
+        raise ValueError(f"stable_dt is the step limit of a fixed-step integrator; {name} adapts "
+                         "its own step (sim.dt is only its first)")
     if name == "rk45":
         raise ValueError(
             "stable_dt is the step limit of a fixed-step integrator; rk45 adapts its own step "

@@ -7,32 +7,41 @@ named tuples of ``engine.state``).
 import numpy as np
 
 from ..forces.pairwise import workspace
-from . import dormand_prince, euler, runge_kutta, splitting, wisdom_holman
+from . import dormand_prince, euler, ias15, janus, runge_kutta, splitting, wisdom_holman
 
 #: the integrators that work on any scene (and in ``engine.Batch``)
 GENERAL = ("euler", "symplectic_euler", "leapfrog", "verlet", "rk4", "yoshida4", "pefrl", "rk45")
 #: every integrator name, in the order of the documentation
-INTEGRATORS = GENERAL + ("whfast",)
+INTEGRATORS = GENERAL + ("whfast", "saba", "ias15", "janus")
 #: the integrators that choose their own steps (``dt`` is only the first)
-ADAPTIVE_INTEGRATORS = ("rk45",)
+ADAPTIVE_INTEGRATORS = ("rk45", "ias15")
 #: integrators built on a dominant mass (Kepler drifts); a scene without one is refused
-KEPLER_SPLITTING = ("whfast",)
+KEPLER_SPLITTING = ("whfast", "saba")
+#: the integrators that take any scene (``engine.Batch`` runs the ``GENERAL`` ones)
+ANY_SCENE = tuple(name for name in INTEGRATORS if name not in KEPLER_SPLITTING)
 
 #: order of accuracy of each integrator (global error ~ dt^order)
 ORDERS = {
     "euler": euler.ORDER, "rk4": runge_kutta.ORDER, "rk45": dormand_prince.ORDER,
     **{name: scheme[2] for name, scheme in splitting.SCHEMES.items()},
     "whfast": wisdom_holman.ORDER,
+    "saba": 4,  # the default SABA(10,6,4): error O(eps h^10 + eps^2 h^6 + eps^3 h^4)
+    "ias15": ias15.ORDER,
+    "janus": 6,  # the default janus_order
 }
 
 #: integrators that conserve a modified energy (bounded energy error) for conservative forces
-SYMPLECTIC = ("symplectic_euler", "leapfrog", "verlet", "yoshida4", "pefrl", "whfast")
+SYMPLECTIC = ("symplectic_euler", "leapfrog", "verlet", "yoshida4", "pefrl", "whfast", "saba",
+              "janus")
 
 #: force evaluations per step (inside one call, position-only forces; rk45: per attempt)
 FORCE_EVALUATIONS = {
     "euler": euler.FORCE_EVALUATIONS, "rk4": runge_kutta.FORCE_EVALUATIONS, "rk45": 6,
     **{name: splitting.force_evaluations(name) for name in splitting.SCHEMES},
     "whfast": 1,  # the standard kernel without corrector (the lazy kernel: 2)
+    "saba": 8,  # the default SABA(10,6,4); SABAn: n, SABACn: n + 2
+    "ias15": 22,  # typical at epsilon 1e-9: 1 + 7 per predictor-corrector iteration
+    "janus": janus.FORCE_EVALUATIONS[6],  # the default janus_order; 1, 5, 9, 15 for 2-8
 }
 
 _COEFFICIENTS = {name: splitting.coefficients(name) for name in splitting.SCHEMES}
@@ -44,13 +53,22 @@ def check_name(name):
     return name
 
 
+_WH_DRIFTS = np.array(wisdom_holman.WH[0])
+_WH_KICKS = np.array(wisdom_holman.WH[1])
+_NO_CORRECTOR = wisdom_holman.corrector_table(0)
+
+
 def advance(name, t, h, steps, state, model, vdep, t_end=np.nan, tol=1e-9, work=None,
-            plan=None, corrector=0, kernel="standard"):
+            plan=None, corrector=0, kernel="standard", saba=wisdom_holman.DEFAULT_SABA,
+            memory=None, janus_order=6, lattice=None):
     """Advance ``state`` by ``steps`` steps of integrator ``name``; see ``common``.
 
     ``state`` and ``model`` are the ``engine.state`` named tuples (``sim.kernel_arguments()``);
-    ``work`` defaults to a fresh ``pairwise.workspace(state.n)``. ``whfast`` also takes the
-    ``wisdom_holman.Plan`` of the scene, its ``corrector`` order and its ``kernel``.
+    ``work`` defaults to a fresh ``pairwise.workspace(state.n)``. ``whfast`` and ``saba`` also
+    take the ``wisdom_holman.Plan`` of the scene; ``whfast`` its ``corrector`` order and its
+    ``kernel``, ``saba`` the name of its method; ``ias15`` its ``memory``
+    (``ias15.new_memory``, kept between calls); ``janus`` its order and ``lattice`` exponents
+    ``(kx, kv)`` (``janus.lattice_exponents``).
     """
     if work is None:
         work = workspace(state.n)
@@ -58,11 +76,27 @@ def advance(name, t, h, steps, state, model, vdep, t_end=np.nan, tol=1e-9, work=
         return wisdom_holman.advance(t, h, steps, state, plan.kick_model, work, vdep, t_end,
                                      *plan.arguments(), plan.kick_com,
                                      wisdom_holman.KERNELS[kernel],
-                                     wisdom_holman.corrector_table(corrector))
+                                     wisdom_holman.corrector_table(corrector), _WH_DRIFTS,
+                                     _WH_KICKS, 0.0)
+    if name == "saba":
+        drifts, kicks, cc = wisdom_holman.saba_scheme(saba)
+        return wisdom_holman.advance(t, h, steps, state, plan.kick_model, work, vdep, t_end,
+                                     *plan.arguments(), plan.kick_com,
+                                     wisdom_holman.KERNEL_STANDARD, _NO_CORRECTOR, drifts, kicks,
+                                     cc)
     if name in _COEFFICIENTS:
         return splitting.advance(t, h, steps, state, model, work, vdep, t_end, *_COEFFICIENTS[name])
     if name == "euler":
         return euler.advance(t, h, steps, state, model, work, vdep, t_end)
+    if name == "ias15":
+        if memory is None:
+            memory = ias15.new_memory(state.pos.shape[0], state.n)
+        return ias15.advance(t, h, steps, state, model, work, vdep, t_end, tol, memory)
+    if name == "janus":
+        kx, kv = (janus.lattice_exponents(state.pos, state.vel, state.n, box=state.box,
+                                          active=state.active, pinned=state.pinned)
+                  if lattice is None else lattice)
+        return janus.advance(t, h, steps, state, model, work, vdep, t_end, janus_order, kx, kv)
     if name == "rk4":
         return runge_kutta.advance(t, h, steps, state, model, work, vdep, t_end)
     return dormand_prince.advance(t, h, steps, state, model, work, vdep, t_end, tol)

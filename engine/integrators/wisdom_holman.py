@@ -2,11 +2,11 @@
 
 The Hamiltonian is split as H = H_Kepler + H_interaction, and a step is the symmetric
 composition drift(h/2) kick(h) drift(h/2), where the drift moves every body exactly on its own
-Kepler orbit (``engine.analytic.kepler_step``, universal variables, whole periods removed
-first) and the kick adds h times the acceleration of everything the Kepler part leaves out
+Kepler orbit (``kepler_drift.drift_column``: universal variables, whole periods removed first,
+``engine.analytic.kepler_step`` where its fast iteration does not meet round-off) and the kick adds h times the acceleration of everything the Kepler part leaves out
 (Wisdom & Holman 1991, AJ 102, 1528; Rein & Tamayo 2015, MNRAS 452, 376). Inside one call the
 half drifts of consecutive steps are merged into one drift, so a step costs one force
-evaluation and one Kepler solve per body; the state is synchronised (the last half drift, the
+evaluation and one Kepler solve per body (``kepler_drift``); the state is synchronised (the last half drift, the
 corrector's inverse, inertial coordinates) when the call ends.
 
 Two kinds of scene:
@@ -44,11 +44,10 @@ import math
 import numpy as np
 from numba import njit
 
-from ..analytic import kepler_step
-from ..forces.dispatch import accelerations
-from ..state import with_motion
+from ..forces.dispatch import accelerations_inline
 from ..space import wrap_scalar
 from .common import OK, all_finite
+from .kepler_drift import drift_column
 
 NAME = "whfast"
 ORDER = 2
@@ -106,7 +105,7 @@ def corrector_table(order):
 
 
 # -- coordinates ------------------------------------------------------------------------------
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _to_jacobi(pos, vel, m, order, count, jp, jv, eta):
     """Jacobi positions and velocities of the bodies ``order[:count]`` (the first is the
     centre) into ``jp``, ``jv`` (column j for order[j]; column 0 the centre of mass), and the
@@ -134,7 +133,7 @@ def _to_jacobi(pos, vel, m, order, count, jp, jv, eta):
         jv[k, 0] /= e
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _from_jacobi(jp, jv, m, order, count, eta, pos, vel, with_vel):
     """Inertial positions (and velocities) from Jacobi ones (the inverse of ``_to_jacobi``):
     with S_j the mass-weighted sum of the first j + 1 bodies, S_{j-1} = (S_j - m r'_j)
@@ -158,7 +157,7 @@ def _from_jacobi(jp, jv, m, order, count, eta, pos, vel, with_vel):
             vel[k, c] = sv / m[c]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _jacobi_accelerations(acc, m, order, count, eta, ja):
     """The Jacobi transform of inertial accelerations (the same map as the positions')."""
     dim = acc.shape[0]
@@ -173,7 +172,7 @@ def _jacobi_accelerations(acc, m, order, count, eta, ja):
 
 
 # -- the two operators ------------------------------------------------------------------------
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _kepler_drift(mode, jp, jv, mu, count, h, r, v, box):
     """Every moving body along its Kepler orbit for time h (mu[j] = 0: a straight line);
     in JACOBI mode column 0, the centre of mass, always moves in a straight line. In a
@@ -186,13 +185,7 @@ def _kepler_drift(mode, jp, jv, mu, count, h, r, v, box):
             jp[k, 0] += h * jv[k, 0]
     for j in range(first, count):
         if mu[j] > 0.0:
-            for k in range(dim):
-                r[k] = jp[k, j]
-                v[k] = jv[k, j]
-            kepler_step(r, v, mu[j], h, r, v)
-            for k in range(dim):
-                jp[k, j] = r[k]
-                jv[k, j] = v[k]
+            drift_column(jp, jv, j, mu[j], h, r, v)
         else:
             for k in range(dim):
                 jp[k, j] += h * jv[k, j]
@@ -201,14 +194,14 @@ def _kepler_drift(mode, jp, jv, mu, count, h, r, v, box):
                 jp[k, j] = wrap_scalar(jp[k, j], box)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)  # one copy of the inlined force table
 def _interaction(mode, t, jp, state, kick_model, work, m, order, count, eta, mu, center, acc,
                  ja, kick_com):
     """The acceleration of the interaction part at the current positions, per coordinate
     column, into ``ja``: ATTRACTOR mode, every other term's acceleration; JACOBI mode, the
     Jacobi transform of every term's plus G eta_j r'_j / |r'_j|^3 (the Kepler part's own
     attraction, taken out). ``state.pos`` must hold the inertial positions."""
-    accelerations(t, state, kick_model, acc, work)
+    accelerations_inline(t, state, kick_model, acc, work)
     dim = jp.shape[0]
     if mode == ATTRACTOR:
         for j in range(count):
@@ -230,7 +223,7 @@ def _interaction(mode, t, jp, state, kick_model, work, m, order, count, eta, mu,
                 ja[k, j] += s * jp[k, j]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _sync_positions(mode, jp, jv, m, order, count, eta, center, pos, vel, with_vel, box):
     """Inertial positions (and velocities) in ``pos``, ``vel`` from the coordinates."""
     dim = jp.shape[0]
@@ -245,7 +238,7 @@ def _sync_positions(mode, jp, jv, m, order, count, eta, center, pos, vel, with_v
                 vel[k, i] = jv[k, j]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _kick(mode, t, h, jp, jv, state, kick_model, work, m, order, count, eta, mu, center, acc,
           ja, kick_com, kernel, shifted, vdep):
     """v' += h a'_interaction; the lazy kernel evaluates a' at positions moved by
@@ -300,7 +293,7 @@ def _corrector(table, sign, h, mode, t, jp, jv, state, kick_model, work, m, orde
         _kepler_drift(mode, jp, jv, mu, count, a, r, v, state.box)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _first_bad_column(jp, jv, count):
     for j in range(count):
         for k in range(jp.shape[0]):
@@ -309,7 +302,7 @@ def _first_bad_column(jp, jv, count):
     return 0
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _coordinates(mode, pos, vel, m, order, count, center, jp, jv, eta, box):
     dim = pos.shape[0]
     if mode == JACOBI:
@@ -322,7 +315,7 @@ def _coordinates(mode, pos, vel, m, order, count, center, jp, jv, eta, box):
             jv[k, j] = vel[k, i]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def kepler_parameters(mode, m, order, count, eta, G, mu_attractor, attracted, mu):
     """mu per coordinate column: G eta_j in JACOBI mode (0 for the centre of mass), the
     attractor's mu for the particles it acts on in ATTRACTOR mode (else 0)."""
@@ -333,24 +326,58 @@ def kepler_parameters(mode, m, order, count, eta, G, mu_attractor, attracted, mu
             mu[j] = mu_attractor if attracted[order[j]] else 0.0
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def _lazy_corrector(cc, h, mode, t, jp, jv, state, kick_model, work, m, order, count, eta, mu,
+                    center, acc, ja, kick_com, shifted, ja0, vdep):
+    """SABA's corrector exp(cc h^3 L_{{A,B},B}) by the lazy implementer's difference
+    (Wisdom, Holman & Touma 1996, eq. 10.6; Rein, Tamayo & Brown 2019, sec. 2.3):
+    v' += 12 cc h (a'(r' + h^2/12 a') - a'(r')), the positions left where they were."""
+    dim = jp.shape[0]
+    pos = state.pos
+    vel = state.vel
+    _sync_positions(mode, jp, jv, m, order, count, eta, center, pos, vel, vdep, state.box)
+    _interaction(mode, t, jp, state, kick_model, work, m, order, count, eta, mu, center, acc,
+                 ja0, kick_com)
+    eps = h * h / 12.0
+    first = 1 if mode == JACOBI else 0
+    for j in range(count):
+        for k in range(dim):
+            shifted[k, j] = jp[k, j] + (eps * ja0[k, j] if j >= first else 0.0)
+    _sync_positions(mode, shifted, jv, m, order, count, eta, center, pos, vel, False, state.box)
+    _interaction(mode, t, shifted, state, kick_model, work, m, order, count, eta, mu, center,
+                 acc, ja, kick_com)
+    f = 12.0 * cc * h
+    for j in range(first, count):
+        for k in range(dim):
+            jv[k, j] += f * (ja[k, j] - ja0[k, j])
+
+
 @njit(cache=True, error_model="numpy")
 def advance(t, h, steps, state, kick_model, work, vdep, t_end, mode, order, m, G, mu_attractor,
-            center, attracted, kick_com, kernel, corrector):
-    """``steps`` Wisdom-Holman steps of ``h`` (see the module). ``order`` lists the particles
-    that move, the centre first in JACOBI mode; ``m`` the masses the coordinates use (test
-    particles 0); ``attracted[i]`` whether the attractor acts on particle i (ATTRACTOR mode);
-    ``corrector`` the table of ``corrector_table``. Returns ``(t, h, done, status)`` as every
-    integrator does; on a non-finite state the last finite one is restored, synchronised."""
+            center, attracted, kick_com, kernel, corrector, drifts, kicks, cc):
+    """``steps`` steps of ``h`` of the splitting ``drifts[0] kicks[0] drifts[1] ... kicks[S-1]
+    drifts[S]`` (fractions of h; Kepler drifts, interaction kicks; see the module).
+
+    ``order`` lists the particles that move, the centre first in JACOBI mode; ``m`` the
+    masses the coordinates use (test particles 0); ``attracted[i]`` whether the attractor acts
+    on particle i (ATTRACTOR mode); ``corrector`` the symplectic corrector's table
+    (``corrector_table``), applied when the call starts and undone when it ends; ``cc`` the
+    coefficient of SABA's lazy corrector applied at both ends of every step (0: none). The
+    last drift of a step and the first of the next are merged when no corrector stands
+    between them. Returns ``(t, h, done, status)`` as every integrator does; on a non-finite
+    state the last finite one is restored, synchronised."""
     pos = state.pos
     vel = state.vel
     dim = pos.shape[0]
     count = order.shape[0]
+    stages = kicks.shape[0]
     jp = np.empty((dim, count))
     jv = np.empty((dim, count))
     save_p = np.empty((dim, count))
     save_v = np.empty((dim, count))
     shifted = np.empty((dim, count))
     ja = np.empty((dim, count))
+    ja0 = np.empty((dim, count))
     eta = np.empty(count)
     mu = np.empty(count)
     acc = np.empty((dim, state.n))
@@ -365,7 +392,10 @@ def advance(t, h, steps, state, kick_model, work, vdep, t_end, mode, order, m, G
     kepler_parameters(mode, m, order, count, eta, G, mu_attractor, attracted, mu)
     _corrector(corrector, 1.0, h, mode, t, jp, jv, state, kick_model, work, m, order, count,
                eta, mu, center, acc, ja, kick_com, r, v, shifted, vdep)
-    _kepler_drift(mode, jp, jv, mu, count, 0.5 * h, r, v, state.box)
+    if cc != 0.0:
+        _lazy_corrector(cc, h, mode, t, jp, jv, state, kick_model, work, m, order, count, eta,
+                        mu, center, acc, ja, kick_com, shifted, ja0, vdep)
+    _kepler_drift(mode, jp, jv, mu, count, drifts[0] * h, r, v, state.box)
     done = 0
     status = OK
     for step in range(steps):
@@ -374,10 +404,24 @@ def advance(t, h, steps, state, kick_model, work, vdep, t_end, mode, order, m, G
             break
         save_p[:, :] = jp
         save_v[:, :] = jv
-        _kick(mode, t + 0.5 * h, h, jp, jv, state, kick_model, work, m, order, count, eta, mu,
-              center, acc, ja, kick_com, kernel, shifted, vdep)
-        _kepler_drift(mode, jp, jv, mu, count, h if step < steps - 1 else 0.5 * h, r, v,
-                      state.box)
+        elapsed = drifts[0]
+        for s in range(stages):
+            _kick(mode, t + elapsed * h, kicks[s] * h, jp, jv, state, kick_model, work, m,
+                  order, count, eta, mu, center, acc, ja, kick_com, kernel, shifted, vdep)
+            if s < stages - 1:
+                _kepler_drift(mode, jp, jv, mu, count, drifts[s + 1] * h, r, v, state.box)
+                elapsed += drifts[s + 1]
+        last = drifts[stages]
+        if step == steps - 1 or cc != 0.0:
+            _kepler_drift(mode, jp, jv, mu, count, last * h, r, v, state.box)
+            if cc != 0.0:
+                _lazy_corrector(cc if step == steps - 1 else 2.0 * cc, h, mode, t + h, jp, jv,
+                                state, kick_model, work, m, order, count, eta, mu, center,
+                                acc, ja, kick_com, shifted, ja0, vdep)
+                if step < steps - 1:
+                    _kepler_drift(mode, jp, jv, mu, count, drifts[0] * h, r, v, state.box)
+        else:
+            _kepler_drift(mode, jp, jv, mu, count, (last + drifts[0]) * h, r, v, state.box)
         if not all_finite(jp, jv, count):
             status = order[_first_bad_column(jp, jv, count)]
             break
@@ -393,10 +437,14 @@ def advance(t, h, steps, state, kick_model, work, vdep, t_end, mode, order, m, G
         done -= 1  # the inverse corrector failed: back to the last step's start
         t = t - h
     if done > 0:
-        # the last finite state: the step that failed began half a drift after it
+        # the last finite state: the step that failed began one first drift (and, with SABA's
+        # corrector, one corrector) after it
         jp[:, :] = save_p
         jv[:, :] = save_v
-        _kepler_drift(mode, jp, jv, mu, count, -0.5 * h, r, v, state.box)
+        _kepler_drift(mode, jp, jv, mu, count, -drifts[0] * h, r, v, state.box)
+        if cc != 0.0:
+            _lazy_corrector(-cc, h, mode, t, jp, jv, state, kick_model, work, m, order, count,
+                            eta, mu, center, acc, ja, kick_com, shifted, ja0, vdep)
         _corrector(corrector, -1.0, h, mode, t, jp, jv, state, kick_model, work, m, order,
                    count, eta, mu, center, acc, ja, kick_com, r, v, shifted, vdep)
         _sync_positions(mode, jp, jv, m, order, count, eta, center, pos, vel, True, state.box)
@@ -405,6 +453,81 @@ def advance(t, h, steps, state, kick_model, work, vdep, t_end, mode, order, m, G
     pos[:, :] = first_p  # nothing finite to stop at after the start: the start, unchanged
     vel[:, :] = first_v
     return t0, h, 0, status
+
+
+# -- the schemes: Wisdom-Holman and the SABA family -----------------------------------------------
+#: drift and kick coefficients (fractions of h) of ``whfast``: drift-kick-drift
+WH = ((0.5, 0.5), (1.0,))
+
+
+def _symmetric(half_drifts, half_kicks, stages):
+    """The full drift (stages + 1) and kick (stages) sequences from their first halves."""
+    drifts = [half_drifts[min(j, stages - j)] for j in range(stages + 1)]
+    kicks = [half_kicks[min(j, stages - 1 - j)] for j in range(stages)]
+    return tuple(drifts), tuple(kicks)
+
+
+_S15 = math.sqrt(15.0)
+_R30 = math.sqrt(30.0)
+_P = math.sqrt(525.0 + 70.0 * _R30)
+_M = math.sqrt(525.0 - 70.0 * _R30)
+#: SABA(n) of Laskar & Robutel 2001 (Celest. Mech. Dyn. Astron. 80, 39), table 1: the kicks at
+#: the Gauss-Legendre nodes with their weights; and the generalised-order methods SABA(10,4),
+#: SABA(8,6,4), SABA(10,6,4) of Blanes, Casas, Farres, Laskar, Makazaga & Murua 2013 (Appl.
+#: Numer. Math. 68, 58), table 3, as REBOUND lists them (Rein, Tamayo & Brown 2019): name ->
+#: (first half of the drifts, first half of the kicks, stages, error orders in h)
+_SABA_HALVES = {
+    "SABA1": ((0.5,), (1.0,), 1, (2,)),
+    "SABA2": ((0.5 - math.sqrt(3.0) / 6.0, math.sqrt(3.0) / 3.0), (0.5,), 2, (4, 2)),
+    "SABA3": ((0.5 - _S15 / 10.0, _S15 / 10.0), (5.0 / 18.0, 4.0 / 9.0), 3, (6, 2)),
+    "SABA4": ((0.5 - _P / 70.0, (_P - _M) / 70.0, _M / 35.0),
+              (0.25 - _R30 / 72.0, 0.25 + _R30 / 72.0), 4, (8, 2)),
+    "SABA(10,4)": ((0.04706710064597250612947887637243678556564,
+                    0.1847569354170881069247376193702560968574,
+                    0.2827060056798362053243616565541452479160,
+                    -0.01453004174289681837857815229683813033908),
+                   (0.1188819173681970199453503950853885936957,
+                    0.2410504605515015657441667865901651105675,
+                    -0.2732866667053238060543113981664559460630,
+                    0.8267085775712504407295884329818044835997), 7, (10, 4)),
+    "SABA(8,6,4)": ((0.0711334264982231177779387300061549964174,
+                     0.241153427956640098736487795326289649618,
+                     0.521411761772814789212136078067994229991,
+                     -0.333698616227678005726562603400438876027),
+                    (0.183083687472197221961703757166430291072,
+                     0.310782859898574869507522291054262796375,
+                     -0.0265646185119588006972121379164987592663,
+                     0.0653961422823734184559721793911134363710), 7, (8, 6, 4)),
+    "SABA(10,6,4)": ((0.03809449742241219545697532230863756534060,
+                      0.1452987161169137492940200726606637497442,
+                      0.2076276957255412507162056113249882065158,
+                      0.4359097036515261592231548624010651844006,
+                      -0.6538612258327867093807117373907094120024),
+                     (0.09585888083707521061077150377145884776921,
+                      0.2044461531429987806805077839164344779763,
+                      0.2170703479789911017143385924306336714532,
+                      -0.01737538195906509300561788011852699719871), 8, (10, 6, 4)),
+}
+#: the lazy corrector's coefficient of SABAC1-4 (Laskar & Robutel 2001, table 2: g/2 with
+#: their g; the signs as REBOUND applies them)
+_SABA_CORRECTOR = {"SABAC1": 1.0 / 12.0, "SABAC2": 0.01116454968463011276968973577058865137738,
+                   "SABAC3": 0.005634593363122809402267823769797538671562,
+                   "SABAC4": 0.003396775048208601331532157783492144}
+#: every SABA method by name; ``Simulation(integrator="saba", saba="SABA(10,6,4)")``
+SABA_METHODS = tuple(_SABA_HALVES) + tuple(_SABA_CORRECTOR)
+DEFAULT_SABA = "SABA(10,6,4)"
+
+
+def saba_scheme(name):
+    """``(drifts, kicks, cc)`` of a SABA method: the drift and kick fractions of h and the
+    lazy corrector's coefficient (0 without)."""
+    if name not in SABA_METHODS:
+        raise ValueError(f"saba must be one of {', '.join(SABA_METHODS)}, got {name!r}")
+    cc = _SABA_CORRECTOR.get(name, 0.0)
+    base = "SABA" + name[5:] if cc else name
+    half_drifts, half_kicks, stages, _ = _SABA_HALVES[base]
+    drifts, kicks = _symmetric(half_drifts, half_kicks, stages)
+    return np.array(drifts), np.array(kicks), cc
 
 
 # -- the plan: which bodies, which coordinates (Python, once per call) ---------------------------
@@ -426,11 +549,11 @@ class Plan:
                 self.attracted)
 
 
-def plan(terms, state, model, pack_terms):
+def plan(terms, state, model, pack_terms, name="whfast"):
     """The Wisdom-Holman plan for a scene, or ValueError naming why it has none.
 
     ``terms`` are the declared force terms (in model order), ``pack_terms(list)`` packs a
-    subset into a ``Model``. A single ``PointMass`` (without softening) makes ATTRACTOR mode;
+    subset into a ``Model``; ``name`` is the integrator the messages name. A single ``PointMass`` (without softening) makes ATTRACTOR mode;
     otherwise a single ``NBodyGravity`` (without softening, in open space) whose heaviest body
     dominates (``DOMINANCE``) makes JACOBI mode."""
     from ..forces import NBodyGravity, PointMass
@@ -444,14 +567,14 @@ def plan(terms, state, model, pack_terms):
     gravities = [s for s, term in enumerate(terms) if isinstance(term, NBodyGravity)]
     dim = state.pos.shape[0]
     if len(attractors) > 1:
-        raise ValueError(f"whfast drifts about one attractor; this scene declares "
+        raise ValueError(f"{name} drifts about one attractor; this scene declares "
                          f"{len(attractors)} PointMass terms")
     if attractors:
         s = attractors[0]
         f0 = model.param_offsets[s]
         mu, eps2 = float(model.params[f0]), float(model.params[f0 + 1])
         if eps2 != 0.0:
-            raise ValueError(f"whfast drifts on exact Kepler orbits about the PointMass: its "
+            raise ValueError(f"{name} drifts on exact Kepler orbits about the PointMass: its "
                              f"softening must be 0, got {eps2 ** 0.5!r}")
         center = np.array(model.params[f0 + 2:f0 + 2 + dim], dtype=np.float64)
         i0, i1 = model.index_offsets[s], model.index_offsets[s + 1]
@@ -464,7 +587,7 @@ def plan(terms, state, model, pack_terms):
         return Plan(ATTRACTOR, moving.astype(np.int64), np.zeros(1), 0.0, mu, center,
                     attracted, pack_terms(others), True)
     if len(gravities) != 1:
-        raise ValueError("whfast needs a dominant mass to drift about: declare a PointMass "
+        raise ValueError(f"{name} needs a dominant mass to drift about: declare a PointMass "
                          "attractor, or NBodyGravity with one body much heavier than the rest"
                          + (f"; this scene declares {len(gravities)} NBodyGravity terms"
                             if gravities else "; this scene declares neither"))
@@ -472,23 +595,23 @@ def plan(terms, state, model, pack_terms):
     f0 = model.param_offsets[s]
     G, eps2 = float(model.params[f0]), float(model.params[f0 + 1])
     if eps2 != 0.0:
-        raise ValueError(f"whfast drifts on exact Kepler orbits: NBodyGravity's softening must "
+        raise ValueError(f"{name} drifts on exact Kepler orbits: NBodyGravity's softening must "
                          f"be 0, got {eps2 ** 0.5!r}")
     if state.box > 0.0:
-        raise ValueError(f"whfast in Jacobi coordinates needs open space, got box={state.box!r} "
+        raise ValueError(f"{name} in Jacobi coordinates needs open space, got box={state.box!r} "
                          "(a PointMass attractor may sit in a periodic space)")
     if (active & pinned).any():
         i = int(np.flatnonzero(active & pinned)[0])
-        raise ValueError(f"whfast in Jacobi coordinates moves every body: particle {i} is "
+        raise ValueError(f"{name} in Jacobi coordinates moves every body: particle {i} is "
                          "pinned (make a fixed central body a PointMass attractor instead)")
     masses = np.where(test, 0.0, np.asarray(state.mass[:n], dtype=np.float64))
     massive = [int(i) for i in moving if masses[i] > 0.0]
     if not massive:
-        raise ValueError("whfast needs a dominant mass to drift about: no active body has mass")
+        raise ValueError(f"{name} needs a dominant mass to drift about: no active body has mass")
     heaviest = max(massive, key=lambda i: (masses[i], -i))
     rest = float(sum(masses[i] for i in massive)) - masses[heaviest]
     if len(massive) > 2 and masses[heaviest] < DOMINANCE * rest:
-        raise ValueError(f"whfast needs a dominant mass: the heaviest body (particle {heaviest}, "
+        raise ValueError(f"{name} needs a dominant mass: the heaviest body (particle {heaviest}, "
                          f"mass {float(masses[heaviest])!r}) carries less than {DOMINANCE:g} times "
                          f"the other bodies' {float(rest)!r}; use a method for any scene "
                          "(engine.integrators.GENERAL) instead")

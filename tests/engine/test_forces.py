@@ -338,7 +338,7 @@ def test_the_drift_wraps_positions_onto_the_periodic_space():
 
 def engine_integrators():
     import engine
-    return engine.integrators.GENERAL  # whfast needs a dominant mass (tests/engine/test_whfast.py)
+    return engine.integrators.ANY_SCENE  # whfast, saba need a dominant mass (test_whfast.py)
 
 
 def test_box_is_checked():

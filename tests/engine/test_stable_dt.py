@@ -20,7 +20,7 @@ G_EARTH = 9.8
 
 def test_the_limits_come_out_of_the_coefficients():
     limits = stability.step_limits()
-    assert set(limits) == set(engine.INTEGRATORS)
+    assert set(limits) == set(engine.INTEGRATORS) - {"ias15"}
     for name in ("symplectic_euler", "leapfrog", "verlet"):
         assert limits[name] == pytest.approx(2.0, abs=1e-12)  # trace G = 2 - z^2
     assert limits["rk4"] == pytest.approx(2.0 * math.sqrt(2.0), abs=1e-12)

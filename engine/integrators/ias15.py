@@ -1,0 +1,711 @@
+"""IAS15: the 15th-order Gauss-Radau predictor-corrector with adaptive steps (``ias15``).
+
+References
+----------
+- E. Everhart, "An efficient integrator that uses Gauss-Radau spacings", in *Dynamics of
+  Comets: Their Origin and Evolution*, IAU Colloq. 83, ASSL 115 (1985) 185: the method, the
+  Gauss-Radau spacings and the predictor of the next step's coefficients.
+- H. Rein, D. S. Spiegel, "IAS15: a fast, adaptive, high-order integrator for gravitational
+  dynamics, accurate to machine precision over a billion orbits", MNRAS 446 (2015) 1424:
+  convergence of the predictor-corrector to machine precision, compensated summation.
+- D. Pham, H. Rein, D. S. Spiegel, "A new timestep criterion for N-body simulations", The
+  Open Journal of Astrophysics 7 (2024) (arXiv:2401.02849): the step-size criterion used here.
+
+The method
+----------
+Over one step of length ``dt`` write the time as ``t0 + s dt`` with ``s`` in [0, 1] and expand
+every acceleration component as a polynomial of degree 7 in ``s``::
+
+    a(s) = a0 + b0 s + b1 s^2 + ... + b6 s^7
+
+Integrating it once and twice gives the velocity and position at any ``s``::
+
+    v(s) = v0 + s dt (a0 + b0 s/2 + b1 s^2/3 + ... + b6 s^7/8)
+    x(s) = x0 + s dt v0 + (s dt)^2 (a0/2 + b0 s/6 + b1 s^2/12 + ... + b6 s^7/72)
+
+The seven unknown ``b`` per component are fixed by collocation at the seven interior
+Gauss-Radau spacings ``h1..h7`` of [0, 1] (with ``h0 = 0`` the eight nodes of Radau quadrature),
+which makes the end-of-step values accurate to order 15. The collocation is solved by
+fixed-point iteration: predict positions (and, for velocity-dependent forces, velocities) at
+node ``h_n`` from the current ``b``, evaluate the forces there, and refresh the Newton
+divided-difference coefficients ``g`` of the acceleration,
+
+    a(s) = a0 + g0 s + g1 s (s - h1) + g2 s (s - h1)(s - h2) + ... + g6 s (s - h1)...(s - h6),
+
+from which the ``b`` follow by the fixed linear map ``b = C^T g`` (``C`` holds the power
+coefficients of the products ``s (s - h1)...(s - hk)``; ``D = C^-1`` maps back). A sweep over
+the seven nodes is one iteration; the iteration stops when the last correction of ``b6``,
+relative to the largest acceleration, is below 1e-16, when that measure no longer decreases
+(from the third iteration on: round-off reached), or after 12 iterations.
+
+The ``b`` of an accepted step predict those of the next one (Everhart): re-expanding the
+step's acceleration polynomial about its end, with the next step ``q`` times as long, gives
+``e_j = q^(j+1) sum_{k>=j} binomial(k+1, j+1) b_k``, and the difference between the converged
+and the predicted ``b`` of the step just taken is added as a correction. A step costs one
+force evaluation at its start plus 7 per iteration; with the warm start it typically takes two
+or three iterations (22.3 evaluations per step on the outer solar system at epsilon 1e-9, as
+REBOUND's IAS15). The predictor lives in a caller-owned ``memory`` array, so it survives
+between calls (``memory_shape``).
+
+Positions and velocities are accumulated across steps with compensated (Kahan) summation, each
+term of the update added separately from the smallest to the largest, and the ``b`` within a
+step likewise: together with steps below the truncation error this makes the energy error a
+random walk (Brouwer's law, error ~ sqrt(time)).
+
+Step size (Pham, Rein & Spiegel 2024)
+-------------------------------------
+After a step, each moving particle's acceleration ``a``, jerk ``j`` and snap ``k`` at the end
+of the step are read off the polynomial, and its timescale is
+
+    tau_i^2 = 2 |a|^2 / (|j|^2 + |a| |k|)
+
+(particles whose acceleration at the start of the step is zero or not normal are skipped). The
+next step is ``dt_new = (7! epsilon)^(1/7) min_i tau_i``; if no particle gives a timescale the
+step grows by 4. A step whose ``dt_new`` is less than a quarter of the step just tried is
+rejected and retried with ``dt_new``; otherwise ``dt_new`` is used next, growing by at most a
+factor 4 per step.
+
+Here ``epsilon`` is the kernel's ``tol`` (default 1e-9, as in REBOUND); ``tol <= 0`` keeps the
+step fixed at ``h`` (REBOUND's epsilon = 0).
+
+Engine conventions: pinned particles do not move (they still exert and feel forces), nor do
+inactive ones; with a periodic box the moving particles are wrapped at the end of each step
+(the compensation term of a wrapped coordinate is dropped); ``t_end`` (not NaN) makes the last
+step land exactly on it, and the step proposed before that shortening is returned as
+``h_next`` (unless the landing step, if at least a quarter of it, asks for less). The time is
+accumulated with compensated summation too (kept in ``memory`` between calls).
+
+Failures return ``(t, h_next, done, status)`` as ``common`` describes, with the state of the
+last accepted step: a non-finite acceleration at the start of a step gives the index of the
+particle at once; a non-finite acceleration at a node or a non-finite result is, with fixed
+steps, the particle's index, and with adaptive steps a rejection (a quarter of the step) until
+the step collapses, then the index. A step collapses (``STEP_COLLAPSED``) when it is no longer
+than 8 eps |t| (eps = 2.2e-16; or below 1e-291): the time could no longer advance by it.
+"""
+import math
+from fractions import Fraction
+
+import numpy as np
+from numba import njit
+
+from ..forces.dispatch import accelerations
+from ..state import with_motion
+from ..space import wrap_scalar
+from .common import OK, STEP_COLLAPSED, TIME_OVERFLOW, active_mask
+
+NAME = "ias15"
+ORDER = 15
+
+# -- the Gauss-Radau constants -------------------------------------------------------------------
+#: Interior Gauss-Radau spacings on [0, 1] (Everhart 1985, table; as quoted by Rein & Spiegel
+#: 2015): with 0 the eight nodes of Radau quadrature, i.e. the roots of
+#: (P_7(x) + P_8(x)) / (1 + x) on [-1, 1] mapped by s = (1 + x) / 2 (checked in the tests).
+SPACINGS = ("0.0562625605369221464656521910318", "0.180240691736892364987579942780",
+            "0.352624717113169637373907769648", "0.547153626330555383001448554766",
+            "0.734210177215410531523210605558", "0.885320946839095768090359771030",
+            "0.977520613561287501891174488626")
+
+
+def _exact_tables():
+    """The node differences, the power coefficients of the Newton basis and their inverse,
+    derived exactly (rational arithmetic on the 30-digit spacings) and then rounded once."""
+    s = [Fraction(0)] + [Fraction(v) for v in SPACINGS]
+    diff = [[s[i] - s[j] if j < i else Fraction(0) for j in range(8)] for i in range(8)]
+    # row k: coefficients of s^1..s^7 in w_k(s) = s (s - h1) ... (s - hk), k = 0..6
+    power = [[Fraction(0)] * 7 for _ in range(7)]
+    poly = [Fraction(1)]  # coefficients of prod_{m<=k} (s - h_m), lowest power first
+    for k in range(7):
+        if k > 0:
+            nxt = [Fraction(0)] * (len(poly) + 1)
+            for p, coef in enumerate(poly):
+                nxt[p + 1] += coef
+                nxt[p] -= s[k] * coef
+            poly = nxt
+        for p, coef in enumerate(poly):
+            power[k][p] = coef  # times s gives s^(p+1): column p
+    # inverse of the (lower triangular, unit diagonal) matrix ``power``, exactly
+    inverse = [[Fraction(int(i == j)) for j in range(7)] for i in range(7)]
+    for i in range(7):
+        for j in range(i):
+            inverse[i][j] = -sum(power[i][m] * inverse[m][j] for m in range(j, i))
+    return s, diff, power, inverse
+
+
+def _as_array(rows):
+    return np.array([[float(v) for v in row] for row in rows], dtype=np.float64)
+
+
+_S, _DIFF, _POWER, _INVERSE = _exact_tables()
+#: the eight nodes 0, h1, ..., h7
+_H = np.array([float(v) for v in _S])
+#: _R[n, j] = h_n - h_j (j < n): the divisors of the divided differences at node n
+_R = _as_array(_DIFF)
+#: b_j = sum_k _C[k, j] g_k  (Everhart's c table, with the unit diagonal)
+_C = _as_array(_POWER)
+#: g_k = sum_j _D[j, k] b_j  (Everhart's d table, with the unit diagonal); _D = _C^-1
+_D = _as_array(_INVERSE)
+#: binomial(k + 1, j + 1): re-expansion of the step's polynomial about its end (predictor)
+_BINOM = np.array([[float(math.comb(k + 1, j + 1)) if k >= j else 0.0 for k in range(7)]
+                   for j in range(7)])
+#: divisors of b_j in the position (j + 2)(j + 3) and velocity (j + 2) updates
+_XDIV = np.array([float((j + 2) * (j + 3)) for j in range(7)])
+_VDIV = np.array([float(j + 2) for j in range(7)])
+#: their reciprocals, for the predictions at the nodes (the end-of-step sums divide)
+_XINV = 1.0 / _XDIV
+_VINV = 1.0 / _VDIV
+
+_MAX_ITERATIONS = 12
+_CONVERGED = 1e-16
+_SAFETY = 0.25          # reject below a quarter of the step tried; grow by at most 1 / _SAFETY
+_NO_PREDICTION = 20.0   # beyond this ratio of steps the predictor is dropped (b = 0)
+_FACTORIAL7 = 5040.0
+_EPS = 2.220446049250313e-16
+_MIN_NORMAL = 2.2250738585072014e-308
+
+# -- the caller-owned memory ---------------------------------------------------------------------
+#: header entries of ``memory`` (then the blocks listed in ``memory_shape``)
+MEMORY_VALID = 0        # 1.0: the blocks hold the state of a previous call; 0.0: cold start
+MEMORY_DT_LAST = 1      # length of the last accepted step (0: none yet)
+MEMORY_DT_PREDICTED = 2  # step length the current b, e were predicted for
+MEMORY_E_VALID = 3      # 1.0 when e holds a prediction (after the first accepted step)
+MEMORY_T = 4            # the time returned by the last call ...
+MEMORY_T_COMPENSATION = 5  # ... and its compensated-summation term (time = t - this)
+MEMORY_EVALUATIONS = 6  # force evaluations, cumulative over calls
+MEMORY_REJECTED = 7     # rejected step attempts, cumulative
+MEMORY_CAPPED = 8       # steps whose predictor-corrector stopped at the 12-iteration cap
+MEMORY_ITERATIONS = 9   # predictor-corrector iterations of accepted steps, cumulative
+HEADER = 10
+_BLOCKS = 32  # b, e, b_done, e_done (7 each), x and v compensation, x and v at the last return
+
+
+def memory_shape(dim, n):
+    """Shape of the ``memory`` array for ``n`` particles in ``dim`` dimensions: a 1-D float64
+    array of ``HEADER + 32 dim n`` entries, laid out as ``HEADER`` scalars (``MEMORY_*``),
+    then b, e, the last accepted step's b and e (each ``(7, dim, n)``), the compensation terms
+    of positions and velocities, and the positions and velocities at the last return (each
+    ``(dim, n)``). A zeroed array is a cold start."""
+    return (HEADER + _BLOCKS * int(dim) * int(n),)
+
+
+def new_memory(dim, n):
+    """A fresh (cold-start) ``memory`` array."""
+    return np.zeros(memory_shape(dim, n))
+
+
+#: force evaluations per predictor-corrector iteration (plus one at the start of each step)
+EVALUATIONS_PER_ITERATION = 7
+
+
+def statistics(memory):
+    """The cumulative counters kept in ``memory``: force evaluations, predictor-corrector
+    iterations of accepted steps, rejected step attempts, and steps whose iteration stopped at
+    the cap of 12 (a sign of steps too long for the problem)."""
+    return {"evaluations": int(memory[MEMORY_EVALUATIONS]),
+            "iterations": int(memory[MEMORY_ITERATIONS]),
+            "rejected": int(memory[MEMORY_REJECTED]),
+            "capped": int(memory[MEMORY_CAPPED])}
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _views(memory, dim, n):
+    m = dim * n
+    o = HEADER
+    b = memory[o:o + 7 * m].reshape((7, dim, n))
+    o += 7 * m
+    e = memory[o:o + 7 * m].reshape((7, dim, n))
+    o += 7 * m
+    b_done = memory[o:o + 7 * m].reshape((7, dim, n))
+    o += 7 * m
+    e_done = memory[o:o + 7 * m].reshape((7, dim, n))
+    o += 7 * m
+    csx = memory[o:o + m].reshape((dim, n))
+    o += m
+    csv = memory[o:o + m].reshape((dim, n))
+    o += m
+    x_end = memory[o:o + m].reshape((dim, n))
+    o += m
+    v_end = memory[o:o + m].reshape((dim, n))
+    return b, e, b_done, e_done, csx, csv, x_end, v_end
+
+
+# -- small pieces ---------------------------------------------------------------------------------
+@njit(cache=True, error_model="numpy")
+def root7(a):
+    """a^(1/7) for a > 0 by Newton's method from above (fixed iteration count, so the result
+    depends only on IEEE arithmetic, not on the platform's pow); NaN for a <= 0 or non-finite."""
+    if a == math.inf:
+        return math.inf
+    if not (a > 0.0 and math.isfinite(a)):
+        return math.nan
+    m, ex = math.frexp(a)
+    q = ex // 7
+    y = math.ldexp(m, ex - 7 * q)  # in [0.5, 64)
+    x = 1.0 + (y - 1.0) / 7.0      # the tangent at 1 lies above the concave root
+    for _ in range(40):
+        x6 = x * x * x
+        x6 = x6 * x6
+        x = (6.0 * x + y / x6) / 7.0
+    return math.ldexp(x, q)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _kahan(total, comp, term):
+    """Compensated sum: returns (total', comp') with total' - comp' = total - comp + term."""
+    y = term - comp
+    s = total + y
+    return s, (s - total) - y
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _first_bad(a, mask, n):
+    for i in range(n):
+        if mask[i] != 0.0:
+            for k in range(a.shape[0]):
+                if not math.isfinite(a[k, i]):
+                    return i
+    return -1
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _predict(b_done, e_done, b, e, ratio):
+    """Everhart's predictor: the b, e for a step ``ratio`` times the last accepted one."""
+    if not (abs(ratio) <= _NO_PREDICTION):
+        b[:] = 0.0
+        e[:] = 0.0
+        return
+    dim = b.shape[1]
+    n = b.shape[2]
+    qj = 1.0
+    for j in range(7):
+        qj *= ratio
+        for k in range(dim):
+            for i in range(n):
+                s = 0.0
+                for m in range(6, j - 1, -1):
+                    s += _BINOM[j, m] * b_done[m, k, i]
+                ej = qj * s
+                e[j, k, i] = ej
+                b[j, k, i] = ej + (b_done[j, k, i] - e_done[j, k, i])
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _rescale(b, ratio):
+    """The same acceleration polynomial over a step ``ratio`` times as long (same start)."""
+    if not (abs(ratio) <= _NO_PREDICTION):
+        b[:] = 0.0
+        return
+    f = 1.0
+    for j in range(7):
+        f *= ratio
+        b[j] *= f
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _iterate(t, dt, state, model, work, vdep, mask, a0, v0, b, csx, csv, g, csb, acc, sx, sv,
+             p, q):
+    """The predictor-corrector on one step attempt. Returns (status, iterations, evaluations):
+    status -1, or the first moving particle with a non-finite acceleration at a node.
+
+    Particles that do not move have a0 = v0 = b = csx = csv = 0 here (``_park``), so the
+    branch-free loops below leave them exactly where they are; their accelerations at the
+    nodes are replaced by a0 (0) before they enter the divided differences."""
+    pos = state.pos
+    vel = state.vel
+    n = state.n
+    dim = pos.shape[0]
+    sub = with_motion(state, sx, sv)
+    for k in range(dim):
+        for i in range(n):
+            sx[k, i] = pos[k, i]
+            sv[k, i] = vel[k, i]
+    # g from b: g_j = sum_{m>=j} D[m, j] b_m; the b's compensation terms start at 0
+    for j in range(7):
+        for k in range(dim):
+            for i in range(n):
+                p[i] = b[j, k, i]
+            for m in range(j + 1, 7):
+                d = _D[m, j]
+                for i in range(n):
+                    p[i] += d * b[m, k, i]
+            for i in range(n):
+                g[j, k, i] = p[i]
+                csb[j, k, i] = 0.0
+    error = 1e300
+    error_last = 2.0
+    iterations = 0
+    evaluations = 0
+    while True:
+        if error < _CONVERGED:
+            break
+        if iterations > 2 and error_last <= error:
+            break  # no longer improving: round-off reached
+        if iterations >= _MAX_ITERATIONS:
+            break
+        error_last = error
+        iterations += 1
+        for node in range(1, 8):
+            s = _H[node]
+            sdt = s * dt
+            # positions (and velocities) at the node from the current b, Horner in s
+            for k in range(dim):
+                for i in range(n):
+                    p[i] = b[6, k, i] * _XINV[6]
+                for j in range(5, -1, -1):
+                    c = _XINV[j]
+                    for i in range(n):
+                        p[i] = p[i] * s + b[j, k, i] * c
+                for i in range(n):
+                    sx[k, i] = pos[k, i] + (sdt * (v0[k, i] + sdt * (p[i] * s + 0.5 * a0[k, i]))
+                                            - csx[k, i])
+            if vdep:
+                for k in range(dim):
+                    for i in range(n):
+                        p[i] = b[6, k, i] * _VINV[6]
+                    for j in range(5, -1, -1):
+                        c = _VINV[j]
+                        for i in range(n):
+                            p[i] = p[i] * s + b[j, k, i] * c
+                    for i in range(n):
+                        sv[k, i] = vel[k, i] + (sdt * (p[i] * s + a0[k, i]) - csv[k, i])
+            accelerations(t + sdt, sub, model, acc, work)
+            evaluations += 1
+            last = node - 1  # the coefficient g_last this node determines
+            r0 = _R[node, 0]
+            finite = 0.0
+            max_a = 0.0
+            max_db = 0.0
+            for k in range(dim):
+                for i in range(n):
+                    a = acc[k, i] if mask[i] != 0.0 else 0.0
+                    finite += a * 0.0
+                    if node == 7:
+                        max_a = max(max_a, abs(a))
+                    p[i] = (a - a0[k, i]) / r0
+                # Newton divided differences: g_last from the node's acceleration
+                for j in range(1, node):
+                    gj = j - 1
+                    r = _R[node, j]
+                    for i in range(n):
+                        p[i] = (p[i] - g[gj, k, i]) / r
+                for i in range(n):
+                    q[i] = p[i] - g[last, k, i]
+                    g[last, k, i] = p[i]
+                # b += C^T (change of g), compensated
+                for j in range(last + 1):
+                    c = _C[last, j]
+                    for i in range(n):
+                        y = c * q[i] - csb[j, k, i]
+                        total = b[j, k, i] + y
+                        csb[j, k, i] = (total - b[j, k, i]) - y
+                        b[j, k, i] = total
+                if node == 7:
+                    for i in range(n):
+                        max_db = max(max_db, abs(q[i]))
+            if finite != 0.0:
+                for i in range(n):
+                    if mask[i] != 0.0:
+                        for k in range(dim):
+                            if not math.isfinite(acc[k, i]):
+                                return i, iterations, evaluations
+            if node == 7:
+                if max_db == 0.0:
+                    error = 0.0
+                elif max_a > 0.0:
+                    error = max_db / max_a
+                else:
+                    error = math.inf
+    return -1, iterations, evaluations
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _park(mask, n, a0, v0, vel, b, e, b_done, e_done, csx, csv):
+    """Zero what moves a particle that must not move (pinned or inactive), so the loops can
+    run over every particle without a branch; v0 is the velocity of the moving ones."""
+    for i in range(n):
+        moving = mask[i] != 0.0
+        for k in range(a0.shape[0]):
+            v0[k, i] = vel[k, i] if moving else 0.0
+            if not moving:
+                a0[k, i] = 0.0
+                csx[k, i] = 0.0
+                csv[k, i] = 0.0
+                for j in range(7):
+                    b[j, k, i] = 0.0
+                    e[j, k, i] = 0.0
+                    b_done[j, k, i] = 0.0
+                    e_done[j, k, i] = 0.0
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _timescale2(a0, b, mask, n):
+    """min over moving particles of tau_i^2 / dt^2 (Pham, Rein & Spiegel 2024), or inf."""
+    dim = a0.shape[0]
+    best = math.inf
+    for i in range(n):
+        if mask[i] == 0.0:
+            continue
+        start = 0.0
+        acc2 = 0.0
+        jerk2 = 0.0
+        snap2 = 0.0
+        for k in range(dim):
+            a = a0[k, i]
+            start += a * a
+            jerk = 0.0
+            snap = 0.0
+            for j in range(7):
+                a += b[j, k, i]
+                jerk += (j + 1) * b[j, k, i]
+                snap += (j + 1) * j * b[j, k, i]
+            acc2 += a * a
+            jerk2 += jerk * jerk
+            snap2 += snap * snap
+        if not (start >= _MIN_NORMAL and start < math.inf):
+            continue  # no acceleration (or an unusable one) at the start of the step
+        tau2 = 2.0 * acc2 / (jerk2 + math.sqrt(snap2 * acc2))
+        if tau2 >= _MIN_NORMAL and tau2 < best:
+            best = tau2
+    return best
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _collapsed(h, t):
+    """A step too short for the time to advance by it reliably (or no longer a normal float)."""
+    return not (abs(h) > 8.0 * _EPS * abs(t) and abs(h) >= _MIN_NORMAL * 2.0 ** 52)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _changed(pos, vel, x_end, v_end, n):
+    for k in range(pos.shape[0]):
+        for i in range(n):
+            if pos[k, i] != x_end[k, i] or vel[k, i] != v_end[k, i]:
+                return True
+    return False
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _store(memory, valid, dt_last, dt_pred, e_valid, t, tc, evaluations, rejected, capped,
+          iterations, pos, vel, x_end, v_end, n):
+    memory[MEMORY_VALID] = 1.0 if valid else 0.0
+    memory[MEMORY_DT_LAST] = dt_last
+    memory[MEMORY_DT_PREDICTED] = dt_pred
+    memory[MEMORY_E_VALID] = 1.0 if e_valid else 0.0
+    memory[MEMORY_T] = t
+    memory[MEMORY_T_COMPENSATION] = tc
+    memory[MEMORY_EVALUATIONS] += evaluations
+    memory[MEMORY_REJECTED] += rejected
+    memory[MEMORY_CAPPED] += capped
+    memory[MEMORY_ITERATIONS] += iterations
+    for k in range(pos.shape[0]):
+        for i in range(n):
+            x_end[k, i] = pos[k, i]
+            v_end[k, i] = vel[k, i]
+
+
+# -- the kernel -----------------------------------------------------------------------------------
+@njit(cache=True, error_model="numpy")
+def advance(t, h, steps, state, model, work, vdep, t_end, tol, memory):
+    """Up to ``steps`` accepted IAS15 steps from time ``t`` with first step ``h``.
+
+    ``tol`` is IAS15's epsilon (> 0: adaptive steps; <= 0: every step is ``h``), ``memory``
+    the caller's array of ``memory_shape(dim, n)`` (zeroed: cold start), updated in place.
+    Returns ``(t, h_next, done, status)`` (``common``)."""
+    pos = state.pos
+    vel = state.vel
+    n = state.n
+    dim = pos.shape[0]
+    if memory.shape[0] != HEADER + _BLOCKS * dim * n:
+        raise ValueError("ias15: memory has the wrong size for this state (see memory_shape)")
+    b, e, b_done, e_done, csx, csv, x_end, v_end = _views(memory, dim, n)
+    mask = active_mask(state.active, state.pinned, n)
+
+    # warm start only if the state is the one this memory left behind
+    warm = memory[MEMORY_VALID] == 1.0 and not _changed(pos, vel, x_end, v_end, n)
+    if warm:
+        dt_last = memory[MEMORY_DT_LAST]
+        dt_pred = memory[MEMORY_DT_PREDICTED]
+        e_valid = memory[MEMORY_E_VALID] == 1.0
+        tc = memory[MEMORY_T_COMPENSATION] if memory[MEMORY_T] == t else 0.0
+    else:
+        memory[HEADER:] = 0.0
+        dt_last = 0.0
+        dt_pred = 0.0
+        e_valid = False
+        tc = 0.0
+
+    adaptive = tol > 0.0
+    growth = root7(tol * _FACTORIAL7) if adaptive else 1.0
+    has_end = not math.isnan(t_end)
+
+    a0 = np.empty((dim, n))
+    acc = np.empty((dim, n))
+    sx = np.empty((dim, n))
+    sv = np.empty((dim, n))
+    nx = np.empty((dim, n))
+    nv = np.empty((dim, n))
+    ncx = np.empty((dim, n))
+    ncv = np.empty((dim, n))
+    v0 = np.empty((dim, n))
+    g = np.empty((7, dim, n))
+    csb = np.empty((7, dim, n))
+    p = np.empty(n)
+    q = np.empty(n)
+
+    evaluations = 0
+    rejected = 0
+    capped = 0
+    iterations_total = 0
+    done = 0
+    need_a0 = True
+    if not (h != 0.0 and math.isfinite(h)):
+        _store(memory, warm, dt_last, dt_pred, e_valid, t, tc, 0, 0, 0, 0, pos, vel, x_end,
+              v_end, n)
+        return t, h, 0, STEP_COLLAPSED
+    while done < steps:
+        dt = h
+        last = False
+        if has_end:
+            remaining = (t_end - t) + tc
+            if t == t_end or remaining == 0.0:
+                t = t_end
+                tc = 0.0
+                break
+            if (h > 0.0) != (remaining > 0.0):
+                h = -h  # towards t_end
+                dt = h
+            if abs(dt) >= abs(remaining):
+                dt = remaining
+                last = True
+        if not math.isfinite(t + dt):
+            _store(memory, False, dt_last, dt_pred, e_valid, t, tc, evaluations, rejected,
+                  capped, iterations_total, pos, vel, x_end, v_end, n)
+            return t, h, done, TIME_OVERFLOW
+        # the predictor for this step length
+        if dt != dt_pred:
+            if dt_last != 0.0:
+                _predict(b_done, e_done, b, e, dt / dt_last)
+                e_valid = True
+            elif dt_pred != 0.0:
+                _rescale(b, dt / dt_pred)  # cold start: the rejected attempt's b, rescaled
+            dt_pred = dt
+        if need_a0:
+            accelerations(t - tc, state, model, a0, work)
+            evaluations += 1
+            bad = _first_bad(a0, mask, n)
+            if bad >= 0:  # nothing a shorter step can cure
+                _store(memory, False, dt_last, dt_pred, e_valid, t, tc, evaluations, rejected,
+                      capped, iterations_total, pos, vel, x_end, v_end, n)
+                return t, h, done, bad
+            _park(mask, n, a0, v0, vel, b, e, b_done, e_done, csx, csv)
+            need_a0 = False
+
+        status, iterations, count = _iterate(t - tc, dt, state, model, work, vdep, mask, a0, v0,
+                                             b, csx, csv, g, csb, acc, sx, sv, p, q)
+        evaluations += count
+        if status < 0:
+            # end-of-step values, each term into the compensated sums, smallest first
+            for k in range(dim):
+                for i in range(n):
+                    if mask[i] == 0.0:
+                        continue
+                    x = pos[k, i]
+                    cx = csx[k, i]
+                    v = vel[k, i]
+                    cv = csv[k, i]
+                    for j in range(6, -1, -1):
+                        x, cx = _kahan(x, cx, b[j, k, i] / _XDIV[j] * dt * dt)
+                    x, cx = _kahan(x, cx, a0[k, i] / 2.0 * dt * dt)
+                    x, cx = _kahan(x, cx, vel[k, i] * dt)
+                    for j in range(6, -1, -1):
+                        v, cv = _kahan(v, cv, b[j, k, i] / _VDIV[j] * dt)
+                    v, cv = _kahan(v, cv, a0[k, i] * dt)
+                    nx[k, i] = x
+                    ncx[k, i] = cx
+                    nv[k, i] = v
+                    ncv[k, i] = cv
+                    if not (math.isfinite(x) and math.isfinite(v)):
+                        if status < 0:
+                            status = i
+        if status >= 0:
+            if not adaptive:
+                _store(memory, False, dt_last, dt_pred, e_valid, t, tc, evaluations, rejected,
+                      capped, iterations_total, pos, vel, x_end, v_end, n)
+                return t, h, done, status
+            # a non-finite node or result: retry with a quarter of the step
+            rejected += 1
+            h = dt * _SAFETY
+            if dt_last == 0.0:
+                b[:] = 0.0  # nothing finite to rescale
+                dt_pred = 0.0
+            if _collapsed(h, t):
+                _store(memory, False, dt_last, dt_pred, e_valid, t, tc, evaluations, rejected,
+                      capped, iterations_total, pos, vel, x_end, v_end, n)
+                return t, h, done, status
+            continue
+
+        if adaptive:
+            tau2 = _timescale2(a0, b, mask, n)
+            if tau2 < math.inf:
+                dt_new = math.sqrt(tau2) * dt * growth
+            else:
+                dt_new = dt / _SAFETY
+            if abs(dt_new) < _SAFETY * abs(dt):
+                rejected += 1
+                h = dt_new
+                if _collapsed(h, t):
+                    _store(memory, False, dt_last, dt_pred, e_valid, t, tc, evaluations,
+                          rejected, capped, iterations_total, pos, vel, x_end, v_end, n)
+                    return t, h, done, STEP_COLLAPSED
+                continue
+            if last:
+                # the proposal before the step was shortened stands, unless a substantial
+                # landing step found a shorter timescale
+                if abs(dt) >= _SAFETY * abs(h) and abs(dt_new) < abs(h):
+                    h = dt_new
+            else:
+                if abs(dt_new) > abs(dt) / _SAFETY:
+                    dt_new = dt / _SAFETY
+                h = dt_new
+        if iterations >= _MAX_ITERATIONS:
+            capped += 1
+        iterations_total += iterations
+
+        # accept
+        for k in range(dim):
+            for i in range(n):
+                if mask[i] != 0.0:
+                    pos[k, i] = nx[k, i]
+                    vel[k, i] = nv[k, i]
+                    csx[k, i] = ncx[k, i]
+                    csv[k, i] = ncv[k, i]
+        box = state.box
+        if box > 0.0:
+            for k in range(dim):
+                for i in range(n):
+                    if mask[i] != 0.0:
+                        x = pos[k, i]
+                        w = wrap_scalar(x, box)
+                        if w != x:
+                            pos[k, i] = w
+                            csx[k, i] = 0.0  # the compensation belonged to the unwrapped value
+        if last:
+            t = t_end
+            tc = 0.0
+        else:
+            t, tc = _kahan(t, tc, dt)
+        b_done[:] = b
+        if e_valid:
+            e_done[:] = e
+        else:
+            e_done[:] = b  # no prediction was made for this step: no correction to carry
+        dt_last = dt
+        _predict(b_done, e_done, b, e, h / dt)
+        e_valid = True
+        dt_pred = h
+        need_a0 = True
+        done += 1
+        if last:
+            break
+    _store(memory, True, dt_last, dt_pred, e_valid, t, tc, evaluations, rejected, capped,
+          iterations_total, pos, vel, x_end, v_end, n)
+    return t, h, done, OK
