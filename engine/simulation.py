@@ -94,6 +94,10 @@ class Simulation(DeclaresTerms):
         self._revision = 0
         self.t = 0.0
         self.steps = 0
+        #: force evaluations made so far: counted by rk45 (rejected attempts included) and
+        #: ias15 (every predictor-corrector iteration); the table
+        #: ``engine.integrators.FORCE_EVALUATIONS`` times the steps for the other methods
+        self.force_evaluations = 0
 
     # -- configuration ---------------------------------------------------------------
     @property
@@ -445,10 +449,18 @@ class Simulation(DeclaresTerms):
         vdep = any(f.velocity_dependent for f in self._forces)
         memory = self._ias15_state(state) if self._integrator == "ias15" else None
         lattice = self._janus_exponents(state) if self._integrator == "janus" else None
+        counts = np.zeros(1, dtype=np.int64)
+        before = _ias15.statistics(memory)["evaluations"] if memory is not None else 0
         t, h_next, done, status = _integrators.advance(
             self._integrator, self._t, h, steps, state, model, vdep, t_end, self._tolerance,
             plan=plan, corrector=self._corrector, kernel=self._kernel, saba=self._saba,
-            memory=memory, janus_order=self._janus_order, lattice=lattice)
+            memory=memory, janus_order=self._janus_order, lattice=lattice, counts=counts)
+        if self._integrator == "rk45":
+            self.force_evaluations += int(counts[0])
+        elif memory is not None:
+            self.force_evaluations += _ias15.statistics(memory)["evaluations"] - before
+        else:
+            self.force_evaluations += self._evaluations_per_step() * done
         failed_step = self.steps + done
         self._t = t
         self.steps += done
@@ -482,6 +494,17 @@ class Simulation(DeclaresTerms):
                 f"{self._integrator} step size collapsed at step {failed_step}, t={t!r} (tolerance "
                 f"{self._tolerance!r} cannot be met); the last accepted state is kept",
                 step=failed_step, time=t, particle=None)
+
+    def _evaluations_per_step(self):
+        name = self._integrator
+        if name == "whfast":
+            return 2 if self._kernel == "lazy" else 1
+        if name == "saba":
+            _, kicks, cc = wisdom_holman.saba_scheme(self._saba)
+            return kicks.shape[0] + (2 if cc else 0)
+        if name == "janus":
+            return _janus.FORCE_EVALUATIONS[self._janus_order]
+        return _integrators.FORCE_EVALUATIONS[name]
 
     def _ias15_state(self, state):
         """IAS15's memory between calls (its predictor's coefficients): kept while the

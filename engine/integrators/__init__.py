@@ -60,7 +60,7 @@ _NO_CORRECTOR = wisdom_holman.corrector_table(0)
 
 def advance(name, t, h, steps, state, model, vdep, t_end=np.nan, tol=1e-9, work=None,
             plan=None, corrector=0, kernel="standard", saba=wisdom_holman.DEFAULT_SABA,
-            memory=None, janus_order=6, lattice=None):
+            memory=None, janus_order=6, lattice=None, counts=None):
     """Advance ``state`` by ``steps`` steps of integrator ``name``; see ``common``.
 
     ``state`` and ``model`` are the ``engine.state`` named tuples (``sim.kernel_arguments()``);
@@ -99,4 +99,7 @@ def advance(name, t, h, steps, state, model, vdep, t_end=np.nan, tol=1e-9, work=
         return janus.advance(t, h, steps, state, model, work, vdep, t_end, janus_order, kx, kv)
     if name == "rk4":
         return runge_kutta.advance(t, h, steps, state, model, work, vdep, t_end)
-    return dormand_prince.advance(t, h, steps, state, model, work, vdep, t_end, tol)
+    if counts is None:
+        counts = np.zeros(1, dtype=np.int64)
+    return dormand_prince.advance_counted(t, h, steps, state, model, work, vdep, t_end, tol,
+                                          counts)

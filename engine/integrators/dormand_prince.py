@@ -78,6 +78,15 @@ def _error(pos, vel, new_pos, new_vel, kx, kv, h, tol, active, n):
 
 @njit(cache=True, error_model="numpy")
 def advance(t, h, steps, state, model, work, vdep, t_end, tol):
+    """``advance_counted`` without the count."""
+    return advance_counted(t, h, steps, state, model, work, vdep, t_end, tol,
+                           np.zeros(1, dtype=np.int64))
+
+
+@njit(cache=True, error_model="numpy")
+def advance_counted(t, h, steps, state, model, work, vdep, t_end, tol, counts):
+    """``steps`` accepted steps (see the module); ``counts[0]`` gains the force evaluations
+    made, rejected attempts included (1 at the start, 6 per attempt)."""
     pos = state.pos
     vel = state.vel
     active = state.active
@@ -92,6 +101,7 @@ def advance(t, h, steps, state, model, work, vdep, t_end, tol):
     has_end = not math.isnan(t_end)
     kx[0, :, :] = vel[:, :n]
     accelerations(t, state, model, kv[0], work)
+    counts[0] += 1
     hold_pinned(kv[0], state.pinned, n)
     done = 0
     rejected = False
@@ -107,6 +117,7 @@ def advance(t, h, steps, state, model, work, vdep, t_end, tol):
                 last = True
         if not math.isfinite(t + h_try):
             return t, h, done, TIME_OVERFLOW
+        counts[0] += 6
         for s in range(1, 7):
             _stage_state(pos, vel, kx, kv, s, h_try, n, sx, sv)
             kx[s, :, :] = sv

@@ -33,6 +33,11 @@ from ..analytic import kepler_step
 
 MAX_ITERATIONS = 12
 _TWO_PI = 2.0 * math.pi
+#: (dt / P)^2 (2 pi)^2 above which an elliptic arc counts as long: dt > P / 20
+_LONG_ARC = (_TWO_PI * 0.05) ** 2
+_R6, _R12, _R20, _R30, _R42, _R56 = 1 / 6, 1 / 12, 1 / 20, 1 / 30, 1 / 42, 1 / 56
+_R72, _R90, _R110, _R132, _R156, _R182, _R210 = (1 / 72, 1 / 90, 1 / 110, 1 / 132, 1 / 156,
+                                                  1 / 182, 1 / 210)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -42,10 +47,11 @@ def stumpff(z):
     while abs(z) > 0.1:
         z *= 0.25
         quarterings += 1
-    c3 = (1.0 - z / 20.0 * (1.0 - z / 42.0 * (1.0 - z / 72.0 * (1.0 - z / 110.0 * (
-        1.0 - z / 156.0 * (1.0 - z / 210.0)))))) / 6.0
-    c2 = (1.0 - z / 12.0 * (1.0 - z / 30.0 * (1.0 - z / 56.0 * (1.0 - z / 90.0 * (
-        1.0 - z / 132.0 * (1.0 - z / 182.0)))))) / 2.0
+    # the series' ratios as products by reciprocals: no division in the hot path
+    c3 = (1.0 - z * _R20 * (1.0 - z * _R42 * (1.0 - z * _R72 * (1.0 - z * _R110 * (
+        1.0 - z * _R156 * (1.0 - z * _R210)))))) * _R6
+    c2 = (1.0 - z * _R12 * (1.0 - z * _R30 * (1.0 - z * _R56 * (1.0 - z * _R90 * (
+        1.0 - z * _R132 * (1.0 - z * _R182)))))) * 0.5
     c1 = 1.0 - z * c3
     c0 = 1.0 - z * c2
     for _ in range(quarterings):
@@ -73,16 +79,24 @@ def drift_column(jp, jv, j, mu, dt, r, v):
     eta0 = x * vx + y * vy + z * vz
     beta = 2.0 * mu / r0 - v2
     zeta0 = mu - beta * r0
-    if beta > 0.0:
+    if beta > 0.0 and dt * dt * beta * beta * beta > _LONG_ARC * mu * mu:
+        # an elliptic arc of more than a twentieth of the period: its whole periods dropped,
+        # then the mean of dX/dt = 1/r over an orbit
         period = _TWO_PI * mu / (beta * math.sqrt(beta))
         if abs(dt) > period:
             dt = np.fmod(dt, period)  # exact
-        if abs(dt) > 0.05 * period:
-            X = dt * beta / mu
-        else:
-            X = dt / r0 * (1.0 - 0.5 * dt * eta0 / (r0 * r0))
+        X = dt * beta / mu
     else:
-        X = dt / r0 * (1.0 - 0.5 * dt * eta0 / (r0 * r0))
+        # X = integral of dt / r, from the Taylor series of 1/r to third order in dt
+        # (r' = eta0 / r0, r'' = (v0^2 - r'^2) / r0 - mu / r0^2): on a short arc one Halley
+        # correction then reaches round-off; on a long open one, the first-order term alone
+        inv = 1.0 / r0
+        rd = eta0 * inv
+        rdd = (v2 - rd * rd) * inv - mu * inv * inv
+        if dt * dt * (v2 + mu * inv) * inv * inv < 0.25:
+            X = dt * inv * (1.0 + dt * inv * (-0.5 * rd + dt * (2.0 * rd * rd * inv - rdd) * _R6))
+        else:
+            X = dt * inv
     converged = False
     G0 = G1 = G2 = G3 = rn = 0.0
     for _ in range(MAX_ITERATIONS):
@@ -97,15 +111,21 @@ def drift_column(jp, jv, j, mu, dt, r, v):
         step = F / (rn - 0.5 * F * F2 / rn)
         X -= step
         if abs(step) <= 2e-16 * abs(X) or F == 0.0:
+            # the G's of the X before this last correction of a few ulps are used as they
+            # are: their change would be below their own rounding
             converged = True
             break
-    if converged:
-        c0, c1, c2, c3 = stumpff(beta * X * X)
-        G1 = X * c1
-        G2 = X * X * c2
-        G0 = c0
-        rn = r0 * G0 + eta0 * G1 + mu * G2
-    if not converged or not (rn > 0.0):
+        if abs(step) <= 1e-7 * abs(X):
+            # Halley's iteration is cubic: this correction leaves X exact to round-off, so
+            # the G's of the new X end the solve
+            c0, c1, c2, c3 = stumpff(beta * X * X)
+            G1 = X * c1
+            G2 = X * X * c2
+            G0 = c0
+            rn = r0 * G0 + eta0 * G1 + mu * G2
+            converged = True
+            break
+    if not converged or not (rn > 0.0) or not math.isfinite(X):
         for k in range(dim):
             r[k] = jp[k, j]
             v[k] = jv[k, j]

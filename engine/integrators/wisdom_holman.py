@@ -54,7 +54,9 @@ ORDER = 2
 
 JACOBI = 0
 ATTRACTOR = 1
-MODES = {"jacobi": JACOBI, "attractor": ATTRACTOR}
+#: JACOBI with gravity the only declared term: the interaction computed in place, fused
+JACOBI_GRAVITY = 2
+MODES = {"jacobi": JACOBI, "attractor": ATTRACTOR, "jacobi_gravity": JACOBI_GRAVITY}
 
 KERNEL_STANDARD = 0
 KERNEL_LAZY = 1
@@ -179,8 +181,8 @@ def _kepler_drift(mode, jp, jv, mu, count, h, r, v, box):
     periodic space (ATTRACTOR mode only) each position relative to the attractor is taken
     back to its nearest image afterwards, the image the attractor's force acts from."""
     dim = jp.shape[0]
-    first = 1 if mode == JACOBI else 0
-    if mode == JACOBI:
+    first = 1 if mode != ATTRACTOR else 0
+    if mode != ATTRACTOR:
         for k in range(dim):
             jp[k, 0] += h * jv[k, 0]
     for j in range(first, count):
@@ -224,10 +226,76 @@ def _interaction(mode, t, jp, state, kick_model, work, m, order, count, eta, mu,
 
 
 @njit(cache=True, error_model="numpy", inline="always")
+def _gravity_interaction(jp, mo, count, massive, eta, mu, G, xs, ad, ja):
+    """JACOBI_GRAVITY mode's interaction acceleration (``_interaction``'s, for mutual
+    gravity alone), on the coordinates' own columns: the inertial positions from the Jacobi
+    ones, every body's pull by the first ``massive`` (the massive bodies; ``mo`` the masses in
+    column order), the Jacobi transform, and the Kepler part's attraction taken out. The pair
+    of the centre and the first body is left out on both sides, and so is that body's Kepler
+    term: they cancel exactly (WH91), and leaving both out keeps the round-off of the largest
+    terms out of the interaction (as REBOUND's WHFast does)."""
+    dim = jp.shape[0]
+    for k in range(dim):
+        s = jp[k, 0] * eta[count - 1]
+        for j in range(count - 1, 0, -1):
+            s = (s - mo[j] * jp[k, j]) / eta[j]
+            xs[k, j] = jp[k, j] + s
+            s *= eta[j - 1]
+        xs[k, 0] = s / mo[0]
+    for j in range(count):
+        for k in range(dim):
+            ad[k, j] = 0.0
+    for j in range(massive):  # pairs of massive bodies, each once (Newton's third law)
+        for i in range(j + 1, massive):
+            if i + j == 1:  # the centre and the first body
+                continue
+            dx = xs[0, i] - xs[0, j]
+            dy = xs[1, i] - xs[1, j]
+            dz = xs[2, i] - xs[2, j] if dim == 3 else 0.0
+            r2 = dx * dx + dy * dy + dz * dz
+            f = G / (r2 * math.sqrt(r2))
+            fj = f * mo[i]
+            fi = f * mo[j]
+            ad[0, j] += fj * dx
+            ad[1, j] += fj * dy
+            ad[0, i] -= fi * dx
+            ad[1, i] -= fi * dy
+            if dim == 3:
+                ad[2, j] += fj * dz
+                ad[2, i] -= fi * dz
+    for j in range(massive, count):  # test particles: pulled by the massive bodies alone
+        for i in range(massive):
+            if i + j == 1:
+                continue
+            dx = xs[0, i] - xs[0, j]
+            dy = xs[1, i] - xs[1, j]
+            dz = xs[2, i] - xs[2, j] if dim == 3 else 0.0
+            r2 = dx * dx + dy * dy + dz * dz
+            f = G * mo[i] / (r2 * math.sqrt(r2))
+            ad[0, j] += f * dx
+            ad[1, j] += f * dy
+            if dim == 3:
+                ad[2, j] += f * dz
+    for k in range(dim):
+        s = mo[0] * ad[k, 0]
+        for j in range(1, count):
+            ja[k, j] = ad[k, j] - s / eta[j - 1]
+            s += mo[j] * ad[k, j]
+        ja[k, 0] = 0.0  # mutual gravity does not move the centre of mass
+    for j in range(2, count):
+        r2 = 0.0
+        for k in range(dim):
+            r2 += jp[k, j] * jp[k, j]
+        f = mu[j] / (r2 * math.sqrt(r2))
+        for k in range(dim):
+            ja[k, j] += f * jp[k, j]
+
+
+@njit(cache=True, error_model="numpy", inline="always")
 def _sync_positions(mode, jp, jv, m, order, count, eta, center, pos, vel, with_vel, box):
     """Inertial positions (and velocities) in ``pos``, ``vel`` from the coordinates."""
     dim = jp.shape[0]
-    if mode == JACOBI:
+    if mode != ATTRACTOR:
         _from_jacobi(jp, jv, m, order, count, eta, pos, vel, with_vel)
         return
     for j in range(count):
@@ -240,7 +308,7 @@ def _sync_positions(mode, jp, jv, m, order, count, eta, center, pos, vel, with_v
 
 @njit(cache=True, error_model="numpy", inline="always")
 def _kick(mode, t, h, jp, jv, state, kick_model, work, m, order, count, eta, mu, center, acc,
-          ja, kick_com, kernel, shifted, vdep):
+          ja, kick_com, kernel, shifted, vdep, mo, xs, ad, massive, G):
     """v' += h a'_interaction; the lazy kernel evaluates a' at positions moved by
     h^2/12 a' first. With velocity-dependent terms the acceleration is taken at the
     velocities half way through the kick (explicit midpoint; the lazy kernel then does not
@@ -248,6 +316,18 @@ def _kick(mode, t, h, jp, jv, state, kick_model, work, m, order, count, eta, mu,
     dim = jp.shape[0]
     pos = state.pos
     vel = state.vel
+    if mode == JACOBI_GRAVITY:
+        _gravity_interaction(jp, mo, count, massive, eta, mu, G, xs, ad, ja)
+        if kernel == KERNEL_LAZY:
+            eps = h * h / 12.0
+            for j in range(count):
+                for k in range(dim):
+                    shifted[k, j] = jp[k, j] + (eps * ja[k, j] if j >= 1 else 0.0)
+            _gravity_interaction(shifted, mo, count, massive, eta, mu, G, xs, ad, ja)
+        for j in range(count):
+            for k in range(dim):
+                jv[k, j] += h * ja[k, j]
+        return
     _sync_positions(mode, jp, jv, m, order, count, eta, center, pos, vel, vdep, state.box)
     _interaction(mode, t, jp, state, kick_model, work, m, order, count, eta, mu, center, acc,
                  ja, kick_com)
@@ -263,7 +343,7 @@ def _kick(mode, t, h, jp, jv, state, kick_model, work, m, order, count, eta, mu,
                      acc, ja, kick_com)
     elif kernel == KERNEL_LAZY:
         eps = h * h / 12.0
-        first = 1 if mode == JACOBI else 0
+        first = 1 if mode != ATTRACTOR else 0
         for j in range(count):
             for k in range(dim):
                 shifted[k, j] = jp[k, j] + (eps * ja[k, j] if j >= first else 0.0)
@@ -278,7 +358,7 @@ def _kick(mode, t, h, jp, jv, state, kick_model, work, m, order, count, eta, mu,
 
 @njit(cache=True, error_model="numpy")
 def _corrector(table, sign, h, mode, t, jp, jv, state, kick_model, work, m, order, count, eta,
-               mu, center, acc, ja, kick_com, r, v, shifted, vdep):
+               mu, center, acc, ja, kick_com, r, v, shifted, vdep, mo, xs, ad, massive, G):
     """The corrector (sign 1) or its inverse (sign -1): Z(a, b) = D(a) K(-b) D(-2a) K(b) D(a)
     for each row (a / h, b / h) of ``table``."""
     for row in range(table.shape[0]):
@@ -286,10 +366,10 @@ def _corrector(table, sign, h, mode, t, jp, jv, state, kick_model, work, m, orde
         b = sign * table[row, 1] * h
         _kepler_drift(mode, jp, jv, mu, count, a, r, v, state.box)
         _kick(mode, t, -b, jp, jv, state, kick_model, work, m, order, count, eta, mu, center,
-              acc, ja, kick_com, KERNEL_STANDARD, shifted, vdep)
+              acc, ja, kick_com, KERNEL_STANDARD, shifted, vdep, mo, xs, ad, massive, G)
         _kepler_drift(mode, jp, jv, mu, count, -2.0 * a, r, v, state.box)
         _kick(mode, t, b, jp, jv, state, kick_model, work, m, order, count, eta, mu, center,
-              acc, ja, kick_com, KERNEL_STANDARD, shifted, vdep)
+              acc, ja, kick_com, KERNEL_STANDARD, shifted, vdep, mo, xs, ad, massive, G)
         _kepler_drift(mode, jp, jv, mu, count, a, r, v, state.box)
 
 
@@ -305,7 +385,7 @@ def _first_bad_column(jp, jv, count):
 @njit(cache=True, error_model="numpy", inline="always")
 def _coordinates(mode, pos, vel, m, order, count, center, jp, jv, eta, box):
     dim = pos.shape[0]
-    if mode == JACOBI:
+    if mode != ATTRACTOR:
         _to_jacobi(pos, vel, m, order, count, jp, jv, eta)
         return
     for j in range(count):
@@ -320,7 +400,7 @@ def kepler_parameters(mode, m, order, count, eta, G, mu_attractor, attracted, mu
     """mu per coordinate column: G eta_j in JACOBI mode (0 for the centre of mass), the
     attractor's mu for the particles it acts on in ATTRACTOR mode (else 0)."""
     for j in range(count):
-        if mode == JACOBI:
+        if mode != ATTRACTOR:
             mu[j] = 0.0 if j == 0 else G * eta[j]
         else:
             mu[j] = mu_attractor if attracted[order[j]] else 0.0
@@ -339,7 +419,7 @@ def _lazy_corrector(cc, h, mode, t, jp, jv, state, kick_model, work, m, order, c
     _interaction(mode, t, jp, state, kick_model, work, m, order, count, eta, mu, center, acc,
                  ja0, kick_com)
     eps = h * h / 12.0
-    first = 1 if mode == JACOBI else 0
+    first = 1 if mode != ATTRACTOR else 0
     for j in range(count):
         for k in range(dim):
             shifted[k, j] = jp[k, j] + (eps * ja0[k, j] if j >= first else 0.0)
@@ -385,13 +465,21 @@ def advance(t, h, steps, state, kick_model, work, vdep, t_end, mode, order, m, G
     v = np.empty(dim)
     if count == 0 or steps == 0:
         return t, h, 0, OK
+    mo = np.empty(count)  # JACOBI_GRAVITY: masses, positions, accelerations by column
+    xs = np.empty((dim, count))
+    ad = np.empty((dim, count))
+    massive = 0
+    for j in range(count):
+        mo[j] = m[order[j]] if mode != ATTRACTOR else 0.0
+        if mo[j] > 0.0:
+            massive = j + 1  # the massive bodies come first
     t0 = t
     first_p = pos.copy()  # the call's starting state: kept bit for bit if its first step fails
     first_v = vel.copy()
     _coordinates(mode, pos, vel, m, order, count, center, jp, jv, eta, state.box)
     kepler_parameters(mode, m, order, count, eta, G, mu_attractor, attracted, mu)
     _corrector(corrector, 1.0, h, mode, t, jp, jv, state, kick_model, work, m, order, count,
-               eta, mu, center, acc, ja, kick_com, r, v, shifted, vdep)
+               eta, mu, center, acc, ja, kick_com, r, v, shifted, vdep, mo, xs, ad, massive, G)
     if cc != 0.0:
         _lazy_corrector(cc, h, mode, t, jp, jv, state, kick_model, work, m, order, count, eta,
                         mu, center, acc, ja, kick_com, shifted, ja0, vdep)
@@ -402,12 +490,15 @@ def advance(t, h, steps, state, kick_model, work, vdep, t_end, mode, order, m, G
         if not all_finite(jp, jv, count):
             status = order[_first_bad_column(jp, jv, count)]
             break
-        save_p[:, :] = jp
-        save_v[:, :] = jv
+        for j in range(count):
+            for k in range(dim):
+                save_p[k, j] = jp[k, j]
+                save_v[k, j] = jv[k, j]
         elapsed = drifts[0]
         for s in range(stages):
             _kick(mode, t + elapsed * h, kicks[s] * h, jp, jv, state, kick_model, work, m,
-                  order, count, eta, mu, center, acc, ja, kick_com, kernel, shifted, vdep)
+                  order, count, eta, mu, center, acc, ja, kick_com, kernel, shifted, vdep, mo, xs,
+                  ad, massive, G)
             if s < stages - 1:
                 _kepler_drift(mode, jp, jv, mu, count, drifts[s + 1] * h, r, v, state.box)
                 elapsed += drifts[s + 1]
@@ -429,7 +520,8 @@ def advance(t, h, steps, state, kick_model, work, vdep, t_end, mode, order, m, G
         done += 1
     if status == OK:
         _corrector(corrector, -1.0, h, mode, t, jp, jv, state, kick_model, work, m, order,
-                   count, eta, mu, center, acc, ja, kick_com, r, v, shifted, vdep)
+                   count, eta, mu, center, acc, ja, kick_com, r, v, shifted, vdep, mo, xs,
+                   ad, massive, G)
         _sync_positions(mode, jp, jv, m, order, count, eta, center, pos, vel, True, state.box)
         if all_finite(pos, vel, state.n):
             return t, h, done, OK
@@ -446,7 +538,8 @@ def advance(t, h, steps, state, kick_model, work, vdep, t_end, mode, order, m, G
             _lazy_corrector(-cc, h, mode, t, jp, jv, state, kick_model, work, m, order, count,
                             eta, mu, center, acc, ja, kick_com, shifted, ja0, vdep)
         _corrector(corrector, -1.0, h, mode, t, jp, jv, state, kick_model, work, m, order,
-                   count, eta, mu, center, acc, ja, kick_com, r, v, shifted, vdep)
+                   count, eta, mu, center, acc, ja, kick_com, r, v, shifted, vdep, mo, xs,
+                   ad, massive, G)
         _sync_positions(mode, jp, jv, m, order, count, eta, center, pos, vel, True, state.box)
         if all_finite(pos, vel, state.n):
             return t, h, done, status
@@ -618,5 +711,6 @@ def plan(terms, state, model, pack_terms, name="whfast"):
     order = [heaviest] + [i for i in massive if i != heaviest]
     order += [int(i) for i in moving if masses[i] == 0.0]
     kick_com = any(not isinstance(term, NBodyGravity) for term in terms)
-    return Plan(JACOBI, np.array(order, dtype=np.int64), masses, G, 0.0, np.zeros(dim),
+    mode = JACOBI if kick_com else JACOBI_GRAVITY
+    return Plan(mode, np.array(order, dtype=np.int64), masses, G, 0.0, np.zeros(dim),
                 np.zeros(1, dtype=np.bool_), model, kick_com)

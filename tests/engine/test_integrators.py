@@ -162,6 +162,23 @@ def test_rk45_rejects_and_adapts_at_pericentre():
     r0, v0 = kepler_initial(0.99)
     np.testing.assert_allclose(sim.pos[0], r0, atol=1e-5)
     assert sim.steps > 50
+    # the rejected attempts are counted: more than one first evaluation and 6 per accepted step
+    assert sim.force_evaluations > 1 + 6 * sim.steps
+
+
+def test_force_evaluations_are_counted():
+    sim = kepler_sim(0.5, "rk45", 1e-3, tolerance=1e-8)
+    sim.step(10)  # a small first step that grows: nothing rejected
+    assert sim.force_evaluations == 1 + 6 * 10
+    sim = kepler_sim(0.5, "leapfrog", 1e-3)
+    sim.step(10)
+    sim.step(5)
+    assert sim.force_evaluations == 15
+    sim = kepler_sim(0.5, "ias15", 1e-3)
+    sim.step(10)
+    # per step one evaluation at its start, then 7 per predictor-corrector iteration (at
+    # least 2 iterations)
+    assert sim.force_evaluations >= 10 * (1 + 14) and (sim.force_evaluations - 10) % 7 == 0
 
 
 def test_rk45_step_counts_accepted_steps_and_adapts_dt():
