@@ -174,7 +174,7 @@ def _jacobi_accelerations(acc, m, order, count, eta, ja):
 
 
 # -- the two operators ------------------------------------------------------------------------
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def _kepler_drift(mode, jp, jv, mu, count, h, r, v, box):
     """Every moving body along its Kepler orbit for time h (mu[j] = 0: a straight line);
     in JACOBI mode column 0, the centre of mass, always moves in a straight line. In a
@@ -225,7 +225,7 @@ def _interaction(mode, t, jp, state, kick_model, work, m, order, count, eta, mu,
                 ja[k, j] += s * jp[k, j]
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def _gravity_interaction(jp, mo, count, massive, eta, mu, G, xs, ad, ja):
     """JACOBI_GRAVITY mode's interaction acceleration (``_interaction``'s, for mutual
     gravity alone), on the coordinates' own columns: the inertial positions from the Jacobi
@@ -306,7 +306,7 @@ def _sync_positions(mode, jp, jv, m, order, count, eta, center, pos, vel, with_v
                 vel[k, i] = jv[k, j]
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def _kick(mode, t, h, jp, jv, state, kick_model, work, m, order, count, eta, mu, center, acc,
           ja, kick_com, kernel, shifted, vdep, mo, xs, ad, massive, G):
     """v' += h a'_interaction; the lazy kernel evaluates a' at positions moved by
@@ -356,7 +356,7 @@ def _kick(mode, t, h, jp, jv, state, kick_model, work, m, order, count, eta, mu,
             jv[k, j] += h * ja[k, j]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def _corrector(table, sign, h, mode, t, jp, jv, state, kick_model, work, m, order, count, eta,
                mu, center, acc, ja, kick_com, r, v, shifted, vdep, mo, xs, ad, massive, G):
     """The corrector (sign 1) or its inverse (sign -1): Z(a, b) = D(a) K(-b) D(-2a) K(b) D(a)
@@ -406,7 +406,7 @@ def kepler_parameters(mode, m, order, count, eta, G, mu_attractor, attracted, mu
             mu[j] = mu_attractor if attracted[order[j]] else 0.0
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def _lazy_corrector(cc, h, mode, t, jp, jv, state, kick_model, work, m, order, count, eta, mu,
                     center, acc, ja, kick_com, shifted, ja0, vdep):
     """SABA's corrector exp(cc h^3 L_{{A,B},B}) by the lazy implementer's difference
@@ -450,7 +450,9 @@ def advance(t, h, steps, state, kick_model, work, vdep, t_end, mode, order, m, G
     vel = state.vel
     dim = pos.shape[0]
     count = order.shape[0]
-    stages = kicks.shape[0]
+    if count == 0 or steps == 0:
+        return t, h, 0, OK
+    # every scratch array made here, once: the loop below runs without reference counting
     jp = np.empty((dim, count))
     jv = np.empty((dim, count))
     save_p = np.empty((dim, count))
@@ -463,19 +465,36 @@ def advance(t, h, steps, state, kick_model, work, vdep, t_end, mode, order, m, G
     acc = np.empty((dim, state.n))
     r = np.empty(dim)
     v = np.empty(dim)
-    if count == 0 or steps == 0:
-        return t, h, 0, OK
     mo = np.empty(count)  # JACOBI_GRAVITY: masses, positions, accelerations by column
     xs = np.empty((dim, count))
     ad = np.empty((dim, count))
+    first_p = pos.copy()  # the call's starting state: kept bit for bit if its first step fails
+    first_v = vel.copy()
+    return _steps(t, h, steps, state, kick_model, work, vdep, mode, order, m, G, mu_attractor,
+                  center, attracted, kick_com, kernel, corrector, drifts, kicks, cc, jp, jv,
+                  save_p, save_v, shifted, ja, ja0, eta, mu, acc, r, v, mo, xs, ad, first_p,
+                  first_v)
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _steps(t, h, steps, state, kick_model, work, vdep, mode, order, m, G, mu_attractor, center,
+           attracted, kick_com, kernel, corrector, drifts, kicks, cc, jp, jv, save_p, save_v,
+           shifted, ja, ja0, eta, mu, acc, r, v, mo, xs, ad, first_p, first_v):
+    """``advance``'s work in the scratch it made, compiled without reference counting (it
+    allocates nothing), as are the operators it calls: a call passing a dozen arrays would
+    otherwise pay two atomic updates per array, more than a small system's physics. The
+    operators are called, not inlined, so that each is compiled once."""
+    pos = state.pos
+    vel = state.vel
+    dim = pos.shape[0]
+    count = order.shape[0]
+    stages = kicks.shape[0]
     massive = 0
     for j in range(count):
         mo[j] = m[order[j]] if mode != ATTRACTOR else 0.0
         if mo[j] > 0.0:
             massive = j + 1  # the massive bodies come first
     t0 = t
-    first_p = pos.copy()  # the call's starting state: kept bit for bit if its first step fails
-    first_v = vel.copy()
     _coordinates(mode, pos, vel, m, order, count, center, jp, jv, eta, state.box)
     kepler_parameters(mode, m, order, count, eta, G, mu_attractor, attracted, mu)
     _corrector(corrector, 1.0, h, mode, t, jp, jv, state, kick_model, work, m, order, count,
@@ -531,8 +550,10 @@ def advance(t, h, steps, state, kick_model, work, vdep, t_end, mode, order, m, G
     if done > 0:
         # the last finite state: the step that failed began one first drift (and, with SABA's
         # corrector, one corrector) after it
-        jp[:, :] = save_p
-        jv[:, :] = save_v
+        for j in range(count):
+            for k in range(dim):
+                jp[k, j] = save_p[k, j]
+                jv[k, j] = save_v[k, j]
         _kepler_drift(mode, jp, jv, mu, count, -drifts[0] * h, r, v, state.box)
         if cc != 0.0:
             _lazy_corrector(-cc, h, mode, t, jp, jv, state, kick_model, work, m, order, count,
@@ -543,8 +564,10 @@ def advance(t, h, steps, state, kick_model, work, vdep, t_end, mode, order, m, G
         _sync_positions(mode, jp, jv, m, order, count, eta, center, pos, vel, True, state.box)
         if all_finite(pos, vel, state.n):
             return t, h, done, status
-    pos[:, :] = first_p  # nothing finite to stop at after the start: the start, unchanged
-    vel[:, :] = first_v
+    for k in range(dim):  # nothing finite to stop at after the start: the start, unchanged
+        for i in range(pos.shape[1]):
+            pos[k, i] = first_p[k, i]
+            vel[k, i] = first_v[k, i]
     return t0, h, 0, status
 
 
