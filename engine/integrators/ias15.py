@@ -89,6 +89,7 @@ import numpy as np
 from numba import njit
 
 from ..forces.dispatch import accelerations
+from . import fused_gravity
 from ..state import with_motion
 from ..space import wrap_scalar
 from .common import OK, STEP_COLLAPSED, TIME_OVERFLOW, active_mask
@@ -301,8 +302,51 @@ def _rescale(b, ratio):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
+def _forces(t, state, model, acc, work, fused):
+    """The accelerations of every declared term; for ``fused`` scenes (one open-space gravity
+    term on a few bodies, ``fused_gravity.applies``) the pair loop inline, each pair once
+    (a_i += G m_j d / (r^2 + eps^2)^(3/2), a_j -= G m_i d / ...), without the force table's
+    call: twenty-odd evaluations a step make that call a large part of a small system's step."""
+    if not fused:
+        accelerations(t, state, model, acc, work)
+        return
+    pos = state.pos
+    mass = state.mass
+    active = state.active
+    n = state.n
+    dim = pos.shape[0]
+    f0 = model.param_offsets[0]
+    G = model.params[f0]
+    eps2 = model.params[f0 + 1]
+    for k in range(dim):
+        for i in range(n):
+            acc[k, i] = 0.0
+    for i in range(n):
+        if not active[i]:
+            continue
+        for j in range(i + 1, n):
+            if not active[j]:
+                continue
+            dx = pos[0, j] - pos[0, i]
+            dy = pos[1, j] - pos[1, i]
+            dz = pos[2, j] - pos[2, i] if dim == 3 else 0.0
+            r2 = dx * dx + dy * dy + dz * dz + eps2
+            f = G / (r2 * math.sqrt(r2))
+            fi = f * mass[j]
+            fj = f * mass[i]
+            acc[0, i] += fi * dx
+            acc[1, i] += fi * dy
+            acc[0, j] -= fj * dx
+            acc[1, j] -= fj * dy
+            if dim == 3:
+                acc[2, i] += fi * dz
+                acc[2, j] -= fj * dz
+
+
+
+@njit(cache=True, error_model="numpy", inline="always")
 def _iterate(t, dt, state, model, work, vdep, mask, a0, v0, b, csx, csv, g, csb, acc, sx, sv,
-             p, q):
+             p, q, fused):
     """The predictor-corrector on one step attempt. Returns (status, iterations, evaluations):
     status -1, or the first moving particle with a non-finite acceleration at a node.
 
@@ -367,7 +411,7 @@ def _iterate(t, dt, state, model, work, vdep, mask, a0, v0, b, csx, csv, g, csb,
                             p[i] = p[i] * s + b[j, k, i] * c
                     for i in range(n):
                         sv[k, i] = vel[k, i] + (sdt * (p[i] * s + a0[k, i]) - csv[k, i])
-            accelerations(t + sdt, sub, model, acc, work)
+            _forces(t + sdt, sub, model, acc, work, fused)
             evaluations += 1
             last = node - 1  # the coefficient g_last this node determines
             r0 = _R[node, 0]
@@ -518,6 +562,7 @@ def advance(t, h, steps, state, model, work, vdep, t_end, tol, memory):
         raise ValueError("ias15: memory has the wrong size for this state (see memory_shape)")
     b, e, b_done, e_done, csx, csv, x_end, v_end = _views(memory, dim, n)
     mask = active_mask(state.active, state.pinned, n)
+    fused = fused_gravity.applies(state, model)
 
     # warm start only if the state is the one this memory left behind
     warm = memory[MEMORY_VALID] == 1.0 and not _changed(pos, vel, x_end, v_end, n)
@@ -589,7 +634,7 @@ def advance(t, h, steps, state, model, work, vdep, t_end, tol, memory):
                 _rescale(b, dt / dt_pred)  # cold start: the rejected attempt's b, rescaled
             dt_pred = dt
         if need_a0:
-            accelerations(t - tc, state, model, a0, work)
+            _forces(t - tc, state, model, a0, work, fused)
             evaluations += 1
             bad = _first_bad(a0, mask, n)
             if bad >= 0:  # nothing a shorter step can cure
@@ -600,7 +645,7 @@ def advance(t, h, steps, state, model, work, vdep, t_end, tol, memory):
             need_a0 = False
 
         status, iterations, count = _iterate(t - tc, dt, state, model, work, vdep, mask, a0, v0,
-                                             b, csx, csv, g, csb, acc, sx, sv, p, q)
+                                             b, csx, csv, g, csb, acc, sx, sv, p, q, fused)
         evaluations += count
         if status < 0:
             # end-of-step values, each term into the compensated sums, smallest first
