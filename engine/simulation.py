@@ -89,6 +89,8 @@ class Simulation(DeclaresTerms):
         self._forces = []
         self._model = None
         self._model_key = None
+        self._plan = None  # whfast's and saba's plan of the scene, and what it was made from
+        self._plan_key = None
         # bumped by every add and remove of a force term: the packed model is keyed on it (a
         # key of the terms' id() would match a removed term's reused address)
         self._revision = 0
@@ -444,8 +446,7 @@ class Simulation(DeclaresTerms):
         self._check_state(state)
         plan = None
         if self._integrator in _integrators.KEPLER_SPLITTING:
-            plan = wisdom_holman.plan(self._forces, state, model,
-                                      lambda terms: pack(terms, self), self._integrator)
+            plan = self._kepler_plan(state, model)
         vdep = any(f.velocity_dependent for f in self._forces)
         memory = self._ias15_state(state) if self._integrator == "ias15" else None
         lattice = self._janus_exponents(state) if self._integrator == "janus" else None
@@ -494,6 +495,20 @@ class Simulation(DeclaresTerms):
                 f"{self._integrator} step size collapsed at step {failed_step}, t={t!r} (tolerance "
                 f"{self._tolerance!r} cannot be met); the last accepted state is kept",
                 step=failed_step, time=t, particle=None)
+
+    def _kepler_plan(self, state, model):
+        """whfast's and saba's plan (``wisdom_holman.plan``), made again only when something
+        it depends on changed: the terms and their parameters, the particles' masses and
+        flags (all of which the user may write between calls)."""
+        n = state.n
+        key = (self._integrator, self._revision, id(model), n, state.box,
+               model.params.tobytes(), state.mass[:n].tobytes(), state.active[:n].tobytes(),
+               state.test[:n].tobytes(), state.pinned[:n].tobytes())
+        if key != self._plan_key:
+            self._plan = wisdom_holman.plan(self._forces, state, model,
+                                            lambda terms: pack(terms, self), self._integrator)
+            self._plan_key = key
+        return self._plan
 
     def _evaluations_per_step(self):
         name = self._integrator

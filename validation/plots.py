@@ -18,10 +18,20 @@ STYLE = {
     "engine:yoshida4": ("tab:green", "-", "P"),
     "engine:pefrl": ("tab:olive", "-", "X"),
     "engine:rk45": ("tab:brown", "-", "*"),
+    "engine:whfast": ("tab:pink", "-", "h"),
+    "engine:whfast_c11": ("deeppink", "-", "h"),
+    "engine:whfast_c17": ("crimson", "-", "h"),
+    "engine:saba": ("teal", "-", "d"),
+    "engine:sabac4": ("darkcyan", "-", "d"),
+    "engine:ias15": ("goldenrod", "-", "p"),
+    "engine:janus": ("darkkhaki", "-", "8"),
     "rebound:ias15": ("black", "--", "o"),
     "rebound:whfast": ("dimgray", "--", "s"),
     "rebound:leapfrog": ("navy", "--", "^"),
     "rebound:saba": ("magenta", "--", "D"),
+    "rebound:whfast_c11": ("gray", "--", "h"),
+    "rebound:whfast_c17": ("darkgray", "--", "h"),
+    "rebound:sabac4": ("orchid", "--", "d"),
 }
 
 

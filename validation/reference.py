@@ -44,7 +44,10 @@ class RebRun:
     """A REBOUND simulation of a problem; states are returned in the problem's coordinates."""
 
     def __init__(self, problem, integrator, dt=None, epsilon=None, count_evaluations=False,
-                 max_evaluations=None):
+                 max_evaluations=None, options=None):
+        """``options``: attributes of REBOUND's integrator to set (``corrector``, ``type``,
+        ``safe_mode``, ...). With ``safe_mode = 0`` every ``steps``/``integrate`` call ends
+        with ``sim.synchronize()``, so the state read afterwards is the synchronised one."""
         import rebound
 
         kinds = [kind for kind, _ in problem.forces]
@@ -76,7 +79,13 @@ class RebRun:
             p[:problem.dim] = problem.pos[i]
             v[:problem.dim] = problem.vel[i]
             sim.add(m=float(source_mass[i]), x=p[0], y=p[1], z=p[2], vx=v[0], vy=v[1], vz=v[2])
+        if self.offset:
+            sim.N_active = 1  # the problem's particles are test particles: no O(N^2) sum
         sim.integrator = integrator
+        self.options = dict(options or {})
+        for name, value in self.options.items():
+            setattr(sim.integrator, name, value)
+        self._synchronize = self.options.get("safe_mode", 1) == 0
         if dt is not None:
             sim.dt = dt
         if epsilon is not None:
@@ -107,12 +116,16 @@ class RebRun:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             self.sim.integrate(t, exact_finish_time=1 if exact else 0)
+            if self._synchronize:
+                self.sim.synchronize()
         self._note(caught)
 
     def steps(self, n):
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             self.sim.steps(int(n))
+            if self._synchronize:
+                self.sim.synchronize()
         self._note(caught)
 
     def _note(self, caught):

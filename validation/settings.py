@@ -1,7 +1,7 @@
 """How much work each level of the report does.
 
-``full`` is the committed report (about 6 minutes on 2 cores), ``quick`` the same sections
-smaller (under a minute), ``smoke`` a hidden seconds-long level used by the tests.
+``full`` is the committed report, ``quick`` the same sections smaller (about a minute and a
+half on 2 cores), ``smoke`` a hidden seconds-long level used by the tests.
 """
 from dataclasses import dataclass
 
@@ -45,6 +45,11 @@ class Level:
     hc_bisect_iterations: int
     hc_flyby_dts: tuple
     workers: int = 2
+    # the work-precision problems of issue 12 and the engine-against-REBOUND table
+    wp_kepler_orbits: int = 100    # Kepler e = 0.9 over this many orbits
+    wp_star_particles: int = 200   # test particles about a fixed star ...
+    wp_star_orbits: float = 20.0   # ... for this many orbits of a = 1
+    wp_pair_seconds: float = 2.0   # time budget of one side-by-side re-timing of a pair
 
 
 FULL = Level(
@@ -63,6 +68,7 @@ FULL = Level(
     hc_pyth_dts=(1e-3, 1e-4, 1e-5, 1e-6), hc_fig8_periods=1000, hc_fig8_steps=(30, 100, 1000),
     hc_spring_ks=(1e2, 1e4, 1e6), hc_spring_steps=30_000, hc_bisect_iterations=24,
     hc_flyby_dts=(1e-3, 1e-4, 1e-5),
+    wp_pair_seconds=5.0,
 )
 
 QUICK = Level(
@@ -81,6 +87,7 @@ QUICK = Level(
     hc_pyth_dts=(1e-3, 1e-4), hc_fig8_periods=100, hc_fig8_steps=(30, 100),
     hc_spring_ks=(1e2, 1e6), hc_spring_steps=10_000, hc_bisect_iterations=16,
     hc_flyby_dts=(1e-3, 1e-4),
+    wp_pair_seconds=1.0,
 )
 
 SMOKE = Level(
@@ -97,6 +104,7 @@ SMOKE = Level(
     hc_pyth_dts=(1e-3,), hc_fig8_periods=3, hc_fig8_steps=(100,),
     hc_spring_ks=(1e4,), hc_spring_steps=2000, hc_bisect_iterations=8,
     hc_flyby_dts=(1e-3,),
+    wp_kepler_orbits=10, wp_star_particles=20, wp_star_orbits=2.0, wp_pair_seconds=0.05,
 )
 
 LEVELS = {"full": FULL, "quick": QUICK, "smoke": SMOKE}

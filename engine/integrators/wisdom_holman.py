@@ -39,6 +39,7 @@ with a_k = k sqrt(7/40) h (coefficients as published in those papers).
 Other declared terms (drag, thrust, Coulomb, springs) enter through the kick; the method is
 then of second order in h for them (its high order in the mass ratio holds only for gravity).
 """
+import functools
 import math
 
 import numpy as np
@@ -90,6 +91,7 @@ _B = {
 CORRECTORS = (0,) + tuple(sorted(_B))
 
 
+@functools.lru_cache(maxsize=None)
 def corrector_table(order):
     """The corrector of ``order`` as rows (a / h, b / h) of its Z operators, in the order they
     are applied (the inverse applies the same rows with b negated). Order 3 is the pair
@@ -634,9 +636,10 @@ SABA_METHODS = tuple(_SABA_HALVES) + tuple(_SABA_CORRECTOR)
 DEFAULT_SABA = "SABA(10,6,4)"
 
 
+@functools.lru_cache(maxsize=None)
 def saba_scheme(name):
     """``(drifts, kicks, cc)`` of a SABA method: the drift and kick fractions of h and the
-    lazy corrector's coefficient (0 without)."""
+    lazy corrector's coefficient (0 without); the arrays are shared: read them only."""
     if name not in SABA_METHODS:
         raise ValueError(f"saba must be one of {', '.join(SABA_METHODS)}, got {name!r}")
     cc = _SABA_CORRECTOR.get(name, 0.0)
