@@ -19,9 +19,12 @@ with project_cache("engine"):
     from .errors import SimulationError
     from .integrators import ADAPTIVE_INTEGRATORS, INTEGRATORS, ORDERS, SYMPLECTIC
     from .simulation import Simulation
+    from . import advisor
+    from .advisor import advise
 
 __version__ = "0.1.0"
 
 __all__ = ["Simulation", "Batch", "space", "state", "SimulationError", "INTEGRATORS", "ADAPTIVE_INTEGRATORS", "ORDERS", "SYMPLECTIC", "forces", "integrators",
            "analytic", "clock", "diagnostics", "stability", "FixedStepClock", "__version__", "atomic",
-           "atomic_write", "check_output_path", "check_output_dir", "OutputPathError"]
+           "atomic_write", "check_output_path", "check_output_dir", "OutputPathError", "advise",
+           "advisor"]

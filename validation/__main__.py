@@ -1,4 +1,5 @@
-"""``python -m validation report --out DIR [--quick]`` | ``python -m validation bench ...``"""
+"""``python -m validation report --out DIR [--quick]`` | ``python -m validation bench ...`` |
+``python -m validation advise --problem NAME --error E [--t-end T]``"""
 import argparse
 import sys
 
@@ -8,11 +9,14 @@ def main(argv=None):
     parser = argparse.ArgumentParser(
         prog="python -m validation",
         description="Validation of the engine against REBOUND and closed forms, and benchmarks.")
-    sub = parser.add_subparsers(dest="command", metavar="{report,bench}")
+    sub = parser.add_subparsers(dest="command", metavar="{report,bench,advise}")
     sub.add_parser("report", add_help=False,
                    help="orbits, energy drift, work-precision and hard cases: DIR/report.md")
     sub.add_parser("bench", add_help=False, help="benchmarks")
-    if not argv or argv[0] not in ("report", "bench"):
+    sub.add_parser("advise", add_help=False,
+                   help="the cheapest integrator and step for a validation problem "
+                        "(engine.advise)")
+    if not argv or argv[0] not in ("report", "bench", "advise"):
         parser.parse_args(argv)  # prints usage / help, or the error for an unknown command
         parser.print_help()
         return 2
@@ -20,6 +24,9 @@ def main(argv=None):
     if command == "report":
         from . import report
         return report.main(rest)
+    if command == "advise":
+        from . import advise
+        return advise.main(rest)
     from . import bench  # written separately; imported only when asked for
     return bench.main(rest)
 
