@@ -40,7 +40,7 @@ def star_with_test_particles(n=200, orbits=20.0, seed=3):
         r = p / (1.0 + e[k] * math.cos(f))
         x = np.array([r * math.cos(f), r * math.sin(f), 0.0])
         v = np.array([-math.sin(f), e[k] + math.cos(f), 0.0]) / math.sqrt(p)
-        R = _rotation(node[k], inc[k], peri[k])
+        R = problems.orbit_rotation(node[k], inc[k], peri[k])
         pos[k], vel[k] = R @ x, R @ v
     period = 2.0 * math.pi
     return problems.Problem(
@@ -52,15 +52,6 @@ def star_with_test_particles(n=200, orbits=20.0, seed=3):
         notes=f"star m = 1 and {n} test particles (test=True: they feel the star, exert "
               f"nothing), a in [1, 2], e in [0, 0.2], i < 0.1, seed {seed}",
         extra={"test": np.concatenate(([False], np.ones(n, dtype=bool)))})
-
-
-def _rotation(node, inc, peri):
-    def rz(x):
-        c, s = math.cos(x), math.sin(x)
-        return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-    c, s = math.cos(inc), math.sin(inc)
-    rx = np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
-    return rz(node) @ rx @ rz(peri)
 
 
 #: name -> (problem factory, metric)

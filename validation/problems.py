@@ -170,7 +170,7 @@ def star_with_test_particles(n=200, orbits=20, seed=3):
         # pericentre state in the orbital plane, then the time from pericentre to mean anomaly
         r, v = analytic.kepler(np.array([r_p, 0.0]), np.array([0.0, v_p]), 1.0,
                                mean[i] * a[i] ** 1.5)
-        rot = _rotation(node[i], inc[i], peri[i])
+        rot = orbit_rotation(node[i], inc[i], peri[i])
         pos[i] = rot @ np.array([r[0], r[1], 0.0])
         vel[i] = rot @ np.array([v[0], v[1], 0.0])
     period = 2.0 * math.pi
@@ -186,7 +186,7 @@ def star_with_test_particles(n=200, orbits=20, seed=3):
               "1)", extra={"seed": seed})
 
 
-def _rotation(node, inc, peri):
+def orbit_rotation(node, inc, peri):
     """R_z(node) R_x(inc) R_z(peri): orbital plane to the reference frame."""
     def rz(x):
         c, s = math.cos(x), math.sin(x)

@@ -57,7 +57,6 @@ JACOBI = 0
 ATTRACTOR = 1
 #: JACOBI with gravity the only declared term: the interaction computed in place, fused
 JACOBI_GRAVITY = 2
-MODES = {"jacobi": JACOBI, "attractor": ATTRACTOR, "jacobi_gravity": JACOBI_GRAVITY}
 
 KERNEL_STANDARD = 0
 KERNEL_LAZY = 1
