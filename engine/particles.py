@@ -67,4 +67,4 @@ class Particles:
     def state(self, box):
         """The arrays as the ``engine.state.State`` the kernels take (views of this storage)."""
         return State(self.pos, self.vel, self.mass, self.charge, self.radius, self.active,
-                     self.test, self.pinned, self.n, box)
+                     self.test, self.pinned, int(self.n), float(box))

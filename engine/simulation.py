@@ -14,6 +14,7 @@ from ._validate import MAX_STEPS, finite_float, nonnegative_float, positive_floa
 from .errors import SimulationError
 from .forces.base import DeclaresTerms
 from .forces.dispatch import pack, potential_terms
+from .integrators import direct
 from .integrators import ias15 as _ias15
 from .integrators import janus as _janus
 from .integrators import wisdom_holman
@@ -455,7 +456,8 @@ class Simulation(DeclaresTerms):
         t, h_next, done, status = _integrators.advance(
             self._integrator, self._t, h, steps, state, model, vdep, t_end, self._tolerance,
             plan=plan, corrector=self._corrector, kernel=self._kernel, saba=self._saba,
-            memory=memory, janus_order=self._janus_order, lattice=lattice, counts=counts)
+            memory=memory, janus_order=self._janus_order, lattice=lattice, counts=counts,
+            direct=True)
         if self._integrator == "rk45":
             self.force_evaluations += int(counts[0])
         elif memory is not None:
@@ -545,7 +547,7 @@ class Simulation(DeclaresTerms):
         unchanged), never reported as a numerical blow-up of the step. A pinned particle's
         velocity written there is set back to zero (nothing moves it).
         """
-        code = first_invalid(state)
+        code = direct.call(first_invalid, (state,))
         if not code:
             return
         field, i = INVALID_FIELDS[code >> 32], code & 0xFFFFFFFF

@@ -214,6 +214,8 @@ def particle_list(name, particles):
 
 def check_particles(name, indices, sim):
     """Raise ValueError if an index of ``indices`` is out of ``sim``'s range."""
+    if indices.shape[0] == 0 or (indices.min() >= 0 and indices.max() < sim.n):
+        return  # the common case, checked without a temporary mask
     bad = (indices < 0) | (indices >= sim.n)
     if np.any(bad):
         k = int(np.flatnonzero(bad)[0])

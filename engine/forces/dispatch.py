@@ -110,24 +110,37 @@ def potential_terms(t, state, model, out):
         out[s] = u
 
 
+#: the model of no terms at all, shared (writable, as numba types read-only arrays apart and
+#: would compile every kernel again for them; with no terms there is nothing to write)
+EMPTY_MODEL = Model(np.zeros(0, dtype=np.int64), np.zeros(0), np.zeros(1, dtype=np.int64),
+                    np.zeros(0, dtype=np.int64), np.zeros(1, dtype=np.int64))
+
+
 def pack(terms, sim):
     """Concatenate the terms' parameters into the ``Model`` the kernels take.
 
     Every term is re-checked against ``sim`` first (indices in range, dimension), so nothing
     changed since it was added can reach the kernels unchecked.
     """
-    param_blocks, index_blocks = [], []
     for term in terms:
         term._check(sim)
+    if not terms:
+        return EMPTY_MODEL
+    param_blocks, index_blocks = [], []
+    param_ends, index_ends = [0], [0]
     for term in terms:
         params, indices = term._pack(sim)
-        param_blocks.append(np.ascontiguousarray(params, dtype=np.float64))
-        index_blocks.append(np.ascontiguousarray(indices, dtype=np.int64))
+        params = np.ascontiguousarray(params, dtype=np.float64)
+        indices = np.ascontiguousarray(indices, dtype=np.int64)
+        param_blocks.append(params)
+        index_blocks.append(indices)
+        # offsets summed in Python: a simulation calls this once per change of its terms,
+        # and for a few terms numpy's per-call cost would be most of the work
+        param_ends.append(param_ends[-1] + params.shape[0])
+        index_ends.append(index_ends[-1] + indices.shape[0])
     kinds = np.array([term.KIND for term in terms], dtype=np.int64)
-    param_offsets = np.zeros(len(terms) + 1, dtype=np.int64)
-    index_offsets = np.zeros(len(terms) + 1, dtype=np.int64)
-    param_offsets[1:] = np.cumsum([a.shape[0] for a in param_blocks]) if terms else []
-    index_offsets[1:] = np.cumsum([a.shape[0] for a in index_blocks]) if terms else []
-    params = np.concatenate(param_blocks) if param_blocks else np.zeros(0)
-    indices = np.concatenate(index_blocks) if index_blocks else np.zeros(0, dtype=np.int64)
+    param_offsets = np.array(param_ends, dtype=np.int64)
+    index_offsets = np.array(index_ends, dtype=np.int64)
+    params = np.concatenate(param_blocks)
+    indices = np.concatenate(index_blocks)
     return Model(kinds, params, param_offsets, indices, index_offsets)

@@ -7,6 +7,7 @@ named tuples of ``engine.state``).
 import numpy as np
 
 from ..forces.pairwise import workspace
+from . import direct as _direct
 from . import dormand_prince, euler, ias15, janus, runge_kutta, splitting, wisdom_holman
 
 #: the integrators that work on any scene (and in ``engine.Batch``)
@@ -58,9 +59,13 @@ _WH_KICKS = np.array(wisdom_holman.WH[1])
 _NO_CORRECTOR = wisdom_holman.corrector_table(0)
 
 
+def _dispatch_call(dispatcher, args):
+    return dispatcher(*args)
+
+
 def advance(name, t, h, steps, state, model, vdep, t_end=np.nan, tol=1e-9, work=None,
             plan=None, corrector=0, kernel="standard", saba=wisdom_holman.DEFAULT_SABA,
-            memory=None, janus_order=6, lattice=None, counts=None):
+            memory=None, janus_order=6, lattice=None, counts=None, direct=False):
     """Advance ``state`` by ``steps`` steps of integrator ``name``; see ``common``.
 
     ``state`` and ``model`` are the ``engine.state`` named tuples (``sim.kernel_arguments()``);
@@ -68,22 +73,26 @@ def advance(name, t, h, steps, state, model, vdep, t_end=np.nan, tol=1e-9, work=
     take the ``wisdom_holman.Plan`` of the scene; ``whfast`` its ``corrector`` order and its
     ``kernel``, ``saba`` the name of its method; ``ias15`` its ``memory``
     (``ias15.new_memory``, kept between calls); ``janus`` its order and ``lattice`` exponents
-    ``(kx, kv)`` (``janus.lattice_exponents``).
+    ``(kx, kv)`` (``janus.lattice_exponents``). ``direct``: the arguments are a
+    ``Simulation``'s own, of fixed types, so whfast, saba and ias15 skip numba's type
+    dispatch (``engine.integrators.direct``).
     """
     if work is None:
         work = workspace(state.n)
-    if name == "whfast":
-        return wisdom_holman.advance(t, h, steps, state, plan.kick_model, work, vdep, t_end,
-                                     *plan.arguments(), plan.kick_com,
-                                     wisdom_holman.KERNELS[kernel],
-                                     wisdom_holman.corrector_table(corrector), _WH_DRIFTS,
-                                     _WH_KICKS, 0.0)
-    if name == "saba":
-        drifts, kicks, cc = wisdom_holman.saba_scheme(saba)
-        return wisdom_holman.advance(t, h, steps, state, plan.kick_model, work, vdep, t_end,
-                                     *plan.arguments(), plan.kick_com,
-                                     wisdom_holman.KERNEL_STANDARD, _NO_CORRECTOR, drifts, kicks,
-                                     cc)
+    run = _direct.call if direct else _dispatch_call
+    if name in ("whfast", "saba"):
+        if name == "whfast":
+            kernel_code, table = wisdom_holman.KERNELS[kernel], wisdom_holman.corrector_table(corrector)
+            drifts, kicks, cc = _WH_DRIFTS, _WH_KICKS, 0.0
+        else:
+            kernel_code, table = wisdom_holman.KERNEL_STANDARD, _NO_CORRECTOR
+            drifts, kicks, cc = wisdom_holman.saba_scheme(saba)
+        mode, order, masses, G, mu, center, attracted = plan.arguments()
+        return run(wisdom_holman.advance,
+                   (float(t), float(h), int(steps), state, plan.kick_model, work, bool(vdep),
+                    float(t_end), int(mode), order, masses, float(G), float(mu), center,
+                    attracted, bool(plan.kick_com), int(kernel_code), table, drifts, kicks,
+                    float(cc)))
     if name in _COEFFICIENTS:
         return splitting.advance(t, h, steps, state, model, work, vdep, t_end, *_COEFFICIENTS[name])
     if name == "euler":
@@ -91,7 +100,8 @@ def advance(name, t, h, steps, state, model, vdep, t_end=np.nan, tol=1e-9, work=
     if name == "ias15":
         if memory is None:
             memory = ias15.new_memory(state.pos.shape[0], state.n)
-        return ias15.advance(t, h, steps, state, model, work, vdep, t_end, tol, memory)
+        return run(ias15.advance, (float(t), float(h), int(steps), state, model, work,
+                                   bool(vdep), float(t_end), float(tol), memory))
     if name == "janus":
         kx, kv = (janus.lattice_exponents(state.pos, state.vel, state.n, box=state.box,
                                           active=state.active, pinned=state.pinned)

@@ -116,12 +116,14 @@ def drift_column(jp, jv, j, mu, dt, r, v):
             converged = True
             break
         if abs(step) <= 1e-7 * abs(X):
-            # Halley's iteration is cubic: this correction leaves X exact to round-off, so
-            # the G's of the new X end the solve
-            c0, c1, c2, c3 = stumpff(beta * X * X)
-            G1 = X * c1
-            G2 = X * X * c2
-            G0 = c0
+            # Halley's iteration is cubic: this correction leaves X exact to round-off. The
+            # G's move with it by their Taylor series to second order in the step
+            # (dG0/dX = -beta G1, dG1/dX = G0, dG2/dX = G1); the third-order terms are below
+            # 1e-21 of the G's, so no second evaluation of the Stumpff functions is needed
+            half = 0.5 * step * step
+            G0, G1, G2 = (G0 + step * beta * G1 - half * beta * G0,
+                          G1 - step * G0 - half * beta * G1,
+                          G2 - step * G1 + half * G0)
             rn = r0 * G0 + eta0 * G1 + mu * G2
             converged = True
             break

@@ -46,6 +46,8 @@ import numpy as np
 from numba import njit
 
 from ..forces.dispatch import accelerations_inline
+from ..forces.gravity import NBodyGravity
+from ..forces.point_mass import PointMass
 from ..space import wrap_scalar
 from .common import OK, all_finite
 from .kepler_drift import drift_column
@@ -329,6 +331,8 @@ def _kick(mode, t, h, jp, jv, state, kick_model, work, m, order, count, eta, mu,
             for k in range(dim):
                 jv[k, j] += h * ja[k, j]
         return
+    if mode == ATTRACTOR and kick_model.kinds.shape[0] == 0:
+        return  # the attractor is the only term: nothing to kick (test particles, a lone orbit)
     _sync_positions(mode, jp, jv, m, order, count, eta, center, pos, vel, vdep, state.box)
     _interaction(mode, t, jp, state, kick_model, work, m, order, count, eta, mu, center, acc,
                  ja, kick_com)
@@ -413,6 +417,8 @@ def _lazy_corrector(cc, h, mode, t, jp, jv, state, kick_model, work, m, order, c
     """SABA's corrector exp(cc h^3 L_{{A,B},B}) by the lazy implementer's difference
     (Wisdom, Holman & Touma 1996, eq. 10.6; Rein, Tamayo & Brown 2019, sec. 2.3):
     v' += 12 cc h (a'(r' + h^2/12 a') - a'(r')), the positions left where they were."""
+    if mode == ATTRACTOR and kick_model.kinds.shape[0] == 0:
+        return  # no interaction: its corrector is zero
     dim = jp.shape[0]
     pos = state.pos
     vel = state.vel
@@ -654,6 +660,9 @@ def saba_scheme(name):
 DOMINANCE = 10.0
 
 
+_NO_MASSES = np.zeros(1)
+
+
 class Plan:
     """What ``advance`` needs beyond the state: built by ``plan`` from a simulation's terms."""
 
@@ -674,13 +683,11 @@ def plan(terms, state, model, pack_terms, name="whfast"):
     subset into a ``Model``; ``name`` is the integrator the messages name. A single ``PointMass`` (without softening) makes ATTRACTOR mode;
     otherwise a single ``NBodyGravity`` (without softening, in open space) whose heaviest body
     dominates (``DOMINANCE``) makes JACOBI mode."""
-    from ..forces import NBodyGravity, PointMass
-
     n = state.n
-    active = np.asarray(state.active[:n])
-    pinned = np.asarray(state.pinned[:n])
-    test = np.asarray(state.test[:n])
-    moving = np.flatnonzero(active & ~pinned)
+    active = state.active[:n]
+    pinned = state.pinned[:n]
+    test = state.test[:n]
+    moving = np.nonzero(active > pinned)[0]  # active and not pinned
     attractors = [s for s, term in enumerate(terms) if isinstance(term, PointMass)]
     gravities = [s for s, term in enumerate(terms) if isinstance(term, NBodyGravity)]
     dim = state.pos.shape[0]
@@ -694,15 +701,15 @@ def plan(terms, state, model, pack_terms, name="whfast"):
         if eps2 != 0.0:
             raise ValueError(f"{name} drifts on exact Kepler orbits about the PointMass: its "
                              f"softening must be 0, got {eps2 ** 0.5!r}")
-        center = np.array(model.params[f0 + 2:f0 + 2 + dim], dtype=np.float64)
+        center = model.params[f0 + 2:f0 + 2 + dim].copy()
         i0, i1 = model.index_offsets[s], model.index_offsets[s + 1]
-        attracted = np.zeros(max(n, 1), dtype=np.bool_)
         if i1 == i0:
-            attracted[:n] = True
+            attracted = np.ones(max(n, 1), dtype=np.bool_)
         else:
+            attracted = np.zeros(max(n, 1), dtype=np.bool_)
             attracted[model.indices[i0:i1]] = True
         others = [term for k, term in enumerate(terms) if k != s]
-        return Plan(ATTRACTOR, moving.astype(np.int64), np.zeros(1), 0.0, mu, center,
+        return Plan(ATTRACTOR, moving.astype(np.int64), _NO_MASSES, 0.0, mu, center,
                     attracted, pack_terms(others), True)
     if len(gravities) != 1:
         raise ValueError(f"{name} needs a dominant mass to drift about: declare a PointMass "
@@ -722,20 +729,20 @@ def plan(terms, state, model, pack_terms, name="whfast"):
         i = int(np.flatnonzero(active & pinned)[0])
         raise ValueError(f"{name} in Jacobi coordinates moves every body: particle {i} is "
                          "pinned (make a fixed central body a PointMass attractor instead)")
-    masses = np.where(test, 0.0, np.asarray(state.mass[:n], dtype=np.float64))
-    massive = [int(i) for i in moving if masses[i] > 0.0]
-    if not massive:
+    masses = np.where(test, 0.0, state.mass[:n])
+    weighs = masses[moving] > 0.0
+    massive = moving[weighs]
+    if massive.shape[0] == 0:
         raise ValueError(f"{name} needs a dominant mass to drift about: no active body has mass")
-    heaviest = max(massive, key=lambda i: (masses[i], -i))
-    rest = float(sum(masses[i] for i in massive)) - masses[heaviest]
-    if len(massive) > 2 and masses[heaviest] < DOMINANCE * rest:
+    heaviest = int(massive[np.argmax(masses[massive])])  # ties: the lowest index
+    rest = float(sum(masses[massive].tolist())) - masses[heaviest]
+    if massive.shape[0] > 2 and masses[heaviest] < DOMINANCE * rest:
         raise ValueError(f"{name} needs a dominant mass: the heaviest body (particle {heaviest}, "
                          f"mass {float(masses[heaviest])!r}) carries less than {DOMINANCE:g} times "
                          f"the other bodies' {float(rest)!r}; use a method for any scene "
                          "(engine.integrators.GENERAL) instead")
-    order = [heaviest] + [i for i in massive if i != heaviest]
-    order += [int(i) for i in moving if masses[i] == 0.0]
+    order = np.concatenate(([heaviest], massive[massive != heaviest], moving[~weighs]))
     kick_com = any(not isinstance(term, NBodyGravity) for term in terms)
     mode = JACOBI if kick_com else JACOBI_GRAVITY
-    return Plan(mode, np.array(order, dtype=np.int64), masses, G, 0.0, np.zeros(dim),
+    return Plan(mode, order.astype(np.int64), masses, G, 0.0, np.zeros(dim),
                 np.zeros(1, dtype=np.bool_), model, kick_com)
