@@ -390,27 +390,22 @@ def _iterate(t, dt, state, model, work, vdep, mask, a0, v0, b, csx, csv, g, csb,
         for node in range(1, 8):
             s = _H[node]
             sdt = s * dt
-            # positions (and velocities) at the node from the current b, Horner in s
+            # positions (and velocities) at the node from the current b, Horner in s, each
+            # component in registers
             for k in range(dim):
                 for i in range(n):
-                    p[i] = b[6, k, i] * _XINV[6]
-                for j in range(5, -1, -1):
-                    c = _XINV[j]
-                    for i in range(n):
-                        p[i] = p[i] * s + b[j, k, i] * c
-                for i in range(n):
-                    sx[k, i] = pos[k, i] + (sdt * (v0[k, i] + sdt * (p[i] * s + 0.5 * a0[k, i]))
+                    x = b[6, k, i] * _XINV[6]
+                    for j in range(5, -1, -1):
+                        x = x * s + b[j, k, i] * _XINV[j]
+                    sx[k, i] = pos[k, i] + (sdt * (v0[k, i] + sdt * (x * s + 0.5 * a0[k, i]))
                                             - csx[k, i])
             if vdep:
                 for k in range(dim):
                     for i in range(n):
-                        p[i] = b[6, k, i] * _VINV[6]
-                    for j in range(5, -1, -1):
-                        c = _VINV[j]
-                        for i in range(n):
-                            p[i] = p[i] * s + b[j, k, i] * c
-                    for i in range(n):
-                        sv[k, i] = vel[k, i] + (sdt * (p[i] * s + a0[k, i]) - csv[k, i])
+                        x = b[6, k, i] * _VINV[6]
+                        for j in range(5, -1, -1):
+                            x = x * s + b[j, k, i] * _VINV[j]
+                        sv[k, i] = vel[k, i] + (sdt * (x * s + a0[k, i]) - csv[k, i])
             _forces(t + sdt, sub, model, acc, work, fused)
             evaluations += 1
             last = node - 1  # the coefficient g_last this node determines
@@ -418,33 +413,25 @@ def _iterate(t, dt, state, model, work, vdep, mask, a0, v0, b, csx, csv, g, csb,
             finite = 0.0
             max_a = 0.0
             max_db = 0.0
+            # per component, fused: the Newton divided differences give g_last from the
+            # node's acceleration, and b += C^T (change of g), compensated
             for k in range(dim):
                 for i in range(n):
                     a = acc[k, i] if mask[i] != 0.0 else 0.0
                     finite += a * 0.0
-                    if node == 7:
-                        max_a = max(max_a, abs(a))
-                    p[i] = (a - a0[k, i]) / r0
-                # Newton divided differences: g_last from the node's acceleration
-                for j in range(1, node):
-                    gj = j - 1
-                    r = _R[node, j]
-                    for i in range(n):
-                        p[i] = (p[i] - g[gj, k, i]) / r
-                for i in range(n):
-                    q[i] = p[i] - g[last, k, i]
-                    g[last, k, i] = p[i]
-                # b += C^T (change of g), compensated
-                for j in range(last + 1):
-                    c = _C[last, j]
-                    for i in range(n):
-                        y = c * q[i] - csb[j, k, i]
+                    x = (a - a0[k, i]) / r0
+                    for j in range(1, node):
+                        x = (x - g[j - 1, k, i]) / _R[node, j]
+                    change = x - g[last, k, i]
+                    g[last, k, i] = x
+                    for j in range(last + 1):
+                        y = _C[last, j] * change - csb[j, k, i]
                         total = b[j, k, i] + y
                         csb[j, k, i] = (total - b[j, k, i]) - y
                         b[j, k, i] = total
-                if node == 7:
-                    for i in range(n):
-                        max_db = max(max_db, abs(q[i]))
+                    if node == 7:
+                        max_a = max(max_a, abs(a))
+                        max_db = max(max_db, abs(change))
             if finite != 0.0:
                 for i in range(n):
                     if mask[i] != 0.0:
