@@ -54,6 +54,11 @@ class Simulation(DeclaresTerms):
         ``"SABAC4"`` (with the lazy corrector), ``"SABA(10,4)"``, ``"SABA(8,6,4)"``,
         ``"SABA(10,6,4)"`` (the default)
     janus_order : ``janus``'s order, 2, 4, 6 (the default) or 8
+    coordinates : ``whfast``'s coordinates for an ``NBodyGravity`` scene with a dominant mass:
+        ``"jacobi"`` (the default; every corrector and kernel) or
+        ``"democratic_heliocentric"`` (heliocentric positions, barycentric velocities: no
+        ordering of the bodies by distance needed, as for close encounters between planets;
+        standard kernel, no corrector)
 
     ``pos``, ``vel``, ``mass``, ``charge`` and ``radius`` are writable views of the state. A
     step first checks them: a non-finite value written there (or a negative mass or radius)
@@ -63,9 +68,10 @@ class Simulation(DeclaresTerms):
 
     def __init__(self, dim=2, integrator="symplectic_euler", dt=1.0, tolerance=1e-9,
                  units=None, G=None, capacity=16, box=None, corrector=0, kernel="standard",
-                 saba=wisdom_holman.DEFAULT_SABA, janus_order=6):
+                 saba=wisdom_holman.DEFAULT_SABA, janus_order=6, coordinates="jacobi"):
         if isinstance(dim, bool) or dim not in (2, 3):
             raise ValueError(f"dim must be 2 or 3, got {dim!r}")
+        self._coordinates = _check_coordinates(coordinates)
         self._corrector = _check_corrector(corrector)
         self._kernel = _check_kernel(kernel)
         self._saba = _check_saba(saba)
@@ -133,6 +139,15 @@ class Simulation(DeclaresTerms):
     @corrector.setter
     def corrector(self, value):
         self._corrector = _check_corrector(value)
+
+    @property
+    def coordinates(self):
+        """``whfast``'s coordinates: ``"jacobi"`` or ``"democratic_heliocentric"``."""
+        return self._coordinates
+
+    @coordinates.setter
+    def coordinates(self, value):
+        self._coordinates = _check_coordinates(value)
 
     @property
     def kernel(self):
@@ -503,12 +518,13 @@ class Simulation(DeclaresTerms):
         it depends on changed: the terms and their parameters, the particles' masses and
         flags (all of which the user may write between calls)."""
         n = state.n
-        key = (self._integrator, self._revision, id(model), n, state.box,
+        key = (self._integrator, self._coordinates, self._revision, id(model), n, state.box,
                model.params.tobytes(), state.mass[:n].tobytes(), state.active[:n].tobytes(),
                state.test[:n].tobytes(), state.pinned[:n].tobytes())
         if key != self._plan_key:
             self._plan = wisdom_holman.plan(self._forces, state, model,
-                                            lambda terms: pack(terms, self), self._integrator)
+                                            lambda terms: pack(terms, self), self._integrator,
+                                            self._coordinates)
             self._plan_key = key
         return self._plan
 
@@ -651,6 +667,13 @@ def _check_corrector(value):
     if isinstance(value, bool) or value not in wisdom_holman.CORRECTORS:
         raise ValueError(f"corrector must be one of {wisdom_holman.CORRECTORS}, got {value!r}")
     return int(value)
+
+
+def _check_coordinates(value):
+    if not isinstance(value, str) or value not in wisdom_holman.COORDINATES:
+        raise ValueError("coordinates must be one of "
+                         f"{', '.join(map(repr, wisdom_holman.COORDINATES))}, got {value!r}")
+    return value
 
 
 def _check_kernel(value):

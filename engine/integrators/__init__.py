@@ -81,6 +81,13 @@ def advance(name, t, h, steps, state, model, vdep, t_end=np.nan, tol=1e-9, work=
         work = workspace(state.n)
     run = _direct.call if direct else _dispatch_call
     if name in ("whfast", "saba"):
+        if plan.mode == wisdom_holman.DEMOCRATIC and (name == "saba" or corrector != 0
+                                                      or kernel != "standard"):
+            raise ValueError(
+                "democratic heliocentric coordinates take whfast's standard kernel without "
+                f"corrector (got integrator={name!r}, corrector={corrector!r}, kernel={kernel!r}): "
+                "the correctors, the lazy kernel and SABA are built for Jacobi coordinates; "
+                "nothing was changed")
         if name == "whfast":
             kernel_code, table = wisdom_holman.KERNELS[kernel], wisdom_holman.corrector_table(corrector)
             drifts, kicks, cc = _WH_DRIFTS, _WH_KICKS, 0.0

@@ -59,6 +59,13 @@ JACOBI = 0
 ATTRACTOR = 1
 #: JACOBI with gravity the only declared term: the interaction computed in place, fused
 JACOBI_GRAVITY = 2
+#: democratic heliocentric coordinates (Duncan, Levison & Lee 1998): heliocentric positions,
+#: barycentric velocities, every body drifting about the central mass alone; the kick is
+#: jump(h/2) interaction(h) jump(h/2), the jump moving every heliocentric position by
+#: h sum_k m_k v_k / m_0
+DEMOCRATIC = 3
+#: the names of Simulation's ``coordinates``
+COORDINATES = ("jacobi", "democratic_heliocentric")
 
 KERNEL_STANDARD = 0
 KERNEL_LAZY = 1
@@ -174,6 +181,155 @@ def _jacobi_accelerations(acc, m, order, count, eta, ja):
             ja[k, j] = acc[k, i] - s / eta[j - 1]
             s += m[i] * acc[k, i]
         ja[k, 0] = s / eta[count - 1]
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _to_democratic(pos, vel, m, order, count, jp, jv, eta):
+    """Democratic heliocentric coordinates of the bodies ``order[:count]`` (the first is the
+    centre): column 0 the centre of mass and its velocity, column j the position relative to
+    the centre and the velocity relative to the centre of mass. ``eta[0]`` is the central
+    mass, the other entries the total mass."""
+    dim = pos.shape[0]
+    c = order[0]
+    total = 0.0
+    for j in range(count):
+        total += m[order[j]]
+    for k in range(dim):
+        sx = 0.0
+        sv = 0.0
+        for j in range(count):
+            i = order[j]
+            sx += m[i] * pos[k, i]
+            sv += m[i] * vel[k, i]
+        jp[k, 0] = sx / total
+        jv[k, 0] = sv / total
+        for j in range(1, count):
+            i = order[j]
+            jp[k, j] = pos[k, i] - pos[k, c]
+            jv[k, j] = vel[k, i] - jv[k, 0]
+    eta[0] = m[c]
+    for j in range(1, count):
+        eta[j] = total
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _from_democratic(jp, jv, m, order, count, eta, pos, vel, with_vel):
+    """Inertial positions (and velocities) from democratic heliocentric ones: the centre at
+    R - sum_j m_j Q_j / M, each body at Q_j from it; the bodies' velocities V + v_j and the
+    centre's V - sum_j m_j v_j / m_0 (so the total momentum is M V)."""
+    dim = jp.shape[0]
+    c = order[0]
+    total = eta[count - 1] if count > 1 else eta[0]
+    for k in range(dim):
+        sx = 0.0
+        sv = 0.0
+        for j in range(1, count):
+            i = order[j]
+            sx += m[i] * jp[k, j]
+            sv += m[i] * jv[k, j]
+        centre = jp[k, 0] - sx / total
+        pos[k, c] = centre
+        for j in range(1, count):
+            pos[k, order[j]] = jp[k, j] + centre
+        if with_vel:
+            vel[k, c] = jv[k, 0] - sv / eta[0]
+            for j in range(1, count):
+                vel[k, order[j]] = jv[k, j] + jv[k, 0]
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _jump(jp, jv, mo, count, massive, m0, h):
+    """The democratic heliocentric jump: every heliocentric position moves by
+    h sum_k m_k v_k / m_0 (the centre's kinetic term, Duncan, Levison & Lee 1998)."""
+    dim = jp.shape[0]
+    for k in range(dim):
+        p = 0.0
+        for j in range(1, massive):
+            p += mo[j] * jv[k, j]
+        shift = h * (p / m0)
+        for j in range(1, count):
+            jp[k, j] += shift
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _democratic_interaction(t, jp, jv, state, kick_model, work, m, order, count, eta, mu, center,
+                            acc, ja, kick_com, mo, massive, G, with_vel):
+    """The interaction acceleration in democratic heliocentric coordinates: with gravity the
+    only term, the pulls among the bodies other than the centre, from the heliocentric
+    positions (test particles pulled by the massive ones); otherwise every term at the
+    inertial positions, less the centre's pull G m_0 Q_j / |Q_j|^3 (in the Kepler part) and
+    less the acceleration of the centre of mass, which moves column 0."""
+    dim = jp.shape[0]
+    if not kick_com:
+        for j in range(count):
+            for k in range(dim):
+                ja[k, j] = 0.0
+        for j in range(1, massive):
+            for i in range(j + 1, massive):
+                dx = jp[0, i] - jp[0, j]
+                dy = jp[1, i] - jp[1, j]
+                dz = jp[2, i] - jp[2, j] if dim == 3 else 0.0
+                r2 = dx * dx + dy * dy + dz * dz
+                f = G / (r2 * math.sqrt(r2))
+                fj = f * mo[i]
+                fi = f * mo[j]
+                ja[0, j] += fj * dx
+                ja[1, j] += fj * dy
+                ja[0, i] -= fi * dx
+                ja[1, i] -= fi * dy
+                if dim == 3:
+                    ja[2, j] += fj * dz
+                    ja[2, i] -= fi * dz
+        for j in range(massive, count):
+            for i in range(1, massive):
+                dx = jp[0, i] - jp[0, j]
+                dy = jp[1, i] - jp[1, j]
+                dz = jp[2, i] - jp[2, j] if dim == 3 else 0.0
+                r2 = dx * dx + dy * dy + dz * dz
+                f = G * mo[i] / (r2 * math.sqrt(r2))
+                ja[0, j] += f * dx
+                ja[1, j] += f * dy
+                if dim == 3:
+                    ja[2, j] += f * dz
+        return
+    _from_democratic(jp, jv, m, order, count, eta, state.pos, state.vel, with_vel)
+    accelerations_inline(t, state, kick_model, acc, work)
+    total = eta[count - 1] if count > 1 else eta[0]
+    for k in range(dim):
+        s = 0.0
+        for j in range(count):
+            s += mo[j] * acc[k, order[j]]
+        ja[k, 0] = s / total
+    for j in range(1, count):
+        i = order[j]
+        r2 = 0.0
+        for k in range(dim):
+            r2 += jp[k, j] * jp[k, j]
+        f = mu[j] / (r2 * math.sqrt(r2))
+        for k in range(dim):
+            ja[k, j] = acc[k, i] + f * jp[k, j] - ja[k, 0]
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _democratic_kick(t, h, jp, jv, state, kick_model, work, m, order, count, eta, mu, center,
+                     acc, ja, kick_com, shifted, vdep, mo, massive, G):
+    """jump(h/2) interaction(h) jump(h/2); velocity-dependent terms at the midpoint velocity,
+    as in the other modes."""
+    dim = jp.shape[0]
+    m0 = mo[0]
+    _jump(jp, jv, mo, count, massive, m0, 0.5 * h)
+    _democratic_interaction(t, jp, jv, state, kick_model, work, m, order, count, eta, mu,
+                            center, acc, ja, kick_com, mo, massive, G, vdep)
+    if vdep:
+        for j in range(count):
+            for k in range(dim):
+                shifted[k, j] = jv[k, j] + 0.5 * h * ja[k, j]
+        _democratic_interaction(t, jp, shifted, state, kick_model, work, m, order, count, eta,
+                                mu, center, acc, ja, kick_com, mo, massive, G, True)
+    for j in range(count):
+        for k in range(dim):
+            jv[k, j] += h * ja[k, j]
+    _jump(jp, jv, mo, count, massive, m0, 0.5 * h)
 
 
 # -- the two operators ------------------------------------------------------------------------
@@ -298,6 +454,9 @@ def _gravity_interaction(jp, mo, count, massive, eta, mu, G, xs, ad, ja):
 def _sync_positions(mode, jp, jv, m, order, count, eta, center, pos, vel, with_vel, box):
     """Inertial positions (and velocities) in ``pos``, ``vel`` from the coordinates."""
     dim = jp.shape[0]
+    if mode == DEMOCRATIC:
+        _from_democratic(jp, jv, m, order, count, eta, pos, vel, with_vel)
+        return
     if mode != ATTRACTOR:
         _from_jacobi(jp, jv, m, order, count, eta, pos, vel, with_vel)
         return
@@ -330,6 +489,10 @@ def _kick(mode, t, h, jp, jv, state, kick_model, work, m, order, count, eta, mu,
         for j in range(count):
             for k in range(dim):
                 jv[k, j] += h * ja[k, j]
+        return
+    if mode == DEMOCRATIC:
+        _democratic_kick(t, h, jp, jv, state, kick_model, work, m, order, count, eta, mu, center,
+                         acc, ja, kick_com, shifted, vdep, mo, massive, G)
         return
     if mode == ATTRACTOR and kick_model.kinds.shape[0] == 0:
         return  # the attractor is the only term: nothing to kick (test particles, a lone orbit)
@@ -390,6 +553,9 @@ def _first_bad_column(jp, jv, count):
 @njit(cache=True, error_model="numpy", inline="always")
 def _coordinates(mode, pos, vel, m, order, count, center, jp, jv, eta, box):
     dim = pos.shape[0]
+    if mode == DEMOCRATIC:
+        _to_democratic(pos, vel, m, order, count, jp, jv, eta)
+        return
     if mode != ATTRACTOR:
         _to_jacobi(pos, vel, m, order, count, jp, jv, eta)
         return
@@ -405,7 +571,9 @@ def kepler_parameters(mode, m, order, count, eta, G, mu_attractor, attracted, mu
     """mu per coordinate column: G eta_j in JACOBI mode (0 for the centre of mass), the
     attractor's mu for the particles it acts on in ATTRACTOR mode (else 0)."""
     for j in range(count):
-        if mode != ATTRACTOR:
+        if mode == DEMOCRATIC:
+            mu[j] = 0.0 if j == 0 else G * eta[0]
+        elif mode != ATTRACTOR:
             mu[j] = 0.0 if j == 0 else G * eta[j]
         else:
             mu[j] = mu_attractor if attracted[order[j]] else 0.0
@@ -676,13 +844,17 @@ class Plan:
                 self.attracted)
 
 
-def plan(terms, state, model, pack_terms, name="whfast"):
+def plan(terms, state, model, pack_terms, name="whfast", coordinates="jacobi"):
     """The Wisdom-Holman plan for a scene, or ValueError naming why it has none.
 
     ``terms`` are the declared force terms (in model order), ``pack_terms(list)`` packs a
     subset into a ``Model``; ``name`` is the integrator the messages name. A single ``PointMass`` (without softening) makes ATTRACTOR mode;
     otherwise a single ``NBodyGravity`` (without softening, in open space) whose heaviest body
-    dominates (``DOMINANCE``) makes JACOBI mode."""
+    dominates (``DOMINANCE``) makes JACOBI mode, or DEMOCRATIC mode with ``coordinates``
+    ``"democratic_heliocentric"``."""
+    if coordinates not in COORDINATES:
+        raise ValueError(f"coordinates must be one of {', '.join(map(repr, COORDINATES))}, "
+                         f"got {coordinates!r}")
     n = state.n
     active = state.active[:n]
     pinned = state.pinned[:n]
@@ -723,11 +895,13 @@ def plan(terms, state, model, pack_terms, name="whfast"):
         raise ValueError(f"{name} drifts on exact Kepler orbits: NBodyGravity's softening must "
                          f"be 0, got {eps2 ** 0.5!r}")
     if state.box > 0.0:
-        raise ValueError(f"{name} in Jacobi coordinates needs open space, got box={state.box!r} "
+        raise ValueError(f"{name} in {coordinates.replace('_', ' ')} coordinates needs open space, "
+                         f"got box={state.box!r} "
                          "(a PointMass attractor may sit in a periodic space)")
     if (active & pinned).any():
         i = int(np.flatnonzero(active & pinned)[0])
-        raise ValueError(f"{name} in Jacobi coordinates moves every body: particle {i} is "
+        raise ValueError(f"{name} in {coordinates.replace('_', ' ')} coordinates moves every body: "
+                         f"particle {i} is "
                          "pinned (make a fixed central body a PointMass attractor instead)")
     masses = np.where(test, 0.0, state.mass[:n])
     weighs = masses[moving] > 0.0
@@ -743,6 +917,9 @@ def plan(terms, state, model, pack_terms, name="whfast"):
                          "(engine.integrators.GENERAL) instead")
     order = np.concatenate(([heaviest], massive[massive != heaviest], moving[~weighs]))
     kick_com = any(not isinstance(term, NBodyGravity) for term in terms)
-    mode = JACOBI if kick_com else JACOBI_GRAVITY
+    if coordinates == "democratic_heliocentric":
+        mode = DEMOCRATIC
+    else:
+        mode = JACOBI if kick_com else JACOBI_GRAVITY
     return Plan(mode, order.astype(np.int64), masses, G, 0.0, np.zeros(dim),
                 np.zeros(1, dtype=np.bool_), model, kick_com)
