@@ -298,7 +298,9 @@ def _rescale(b, ratio):
     f = 1.0
     for j in range(7):
         f *= ratio
-        b[j] *= f
+        for k in range(b.shape[1]):
+            for i in range(b.shape[2]):
+                b[j, k, i] *= f
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -506,6 +508,14 @@ def _collapsed(h, t):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
+def _copy3(source, target):
+    for j in range(source.shape[0]):
+        for k in range(source.shape[1]):
+            for i in range(source.shape[2]):
+                target[j, k, i] = source[j, k, i]
+
+
+@njit(cache=True, error_model="numpy", inline="always")
 def _changed(pos, vel, x_end, v_end, n):
     for k in range(pos.shape[0]):
         for i in range(n):
@@ -541,14 +551,40 @@ def advance(t, h, steps, state, model, work, vdep, t_end, tol, memory):
     ``tol`` is IAS15's epsilon (> 0: adaptive steps; <= 0: every step is ``h``), ``memory``
     the caller's array of ``memory_shape(dim, n)`` (zeroed: cold start), updated in place.
     Returns ``(t, h_next, done, status)`` (``common``)."""
+    n = state.n
+    dim = state.pos.shape[0]
+    if memory.shape[0] != HEADER + _BLOCKS * dim * n:
+        raise ValueError("ias15: memory has the wrong size for this state (see memory_shape)")
+    mask = active_mask(state.active, state.pinned, n)
+    # every scratch array made here, once: the steps run in ``_advance``, compiled without
+    # reference counting (with it, each array taken out of a named tuple in the inlined loops
+    # paid atomic reference-count updates at every node)
+    a0 = np.empty((dim, n))
+    acc = np.empty((dim, n))
+    sx = np.empty((dim, n))
+    sv = np.empty((dim, n))
+    nx = np.empty((dim, n))
+    nv = np.empty((dim, n))
+    ncx = np.empty((dim, n))
+    ncv = np.empty((dim, n))
+    v0 = np.empty((dim, n))
+    g = np.empty((7, dim, n))
+    csb = np.empty((7, dim, n))
+    p = np.empty(n)
+    q = np.empty(n)
+    return _advance(t, h, steps, state, model, work, vdep, t_end, tol, memory, mask, a0, acc,
+                    sx, sv, nx, nv, ncx, ncv, v0, g, csb, p, q)
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _advance(t, h, steps, state, model, work, vdep, t_end, tol, memory, mask, a0, acc, sx, sv,
+             nx, nv, ncx, ncv, v0, g, csb, p, q):
+    """``advance``'s work, in the scratch it made."""
     pos = state.pos
     vel = state.vel
     n = state.n
     dim = pos.shape[0]
-    if memory.shape[0] != HEADER + _BLOCKS * dim * n:
-        raise ValueError("ias15: memory has the wrong size for this state (see memory_shape)")
     b, e, b_done, e_done, csx, csv, x_end, v_end = _views(memory, dim, n)
-    mask = active_mask(state.active, state.pinned, n)
     fused = fused_gravity.applies(state, model)
 
     # warm start only if the state is the one this memory left behind
@@ -569,19 +605,6 @@ def advance(t, h, steps, state, model, work, vdep, t_end, tol, memory):
     growth = root7(tol * _FACTORIAL7) if adaptive else 1.0
     has_end = not math.isnan(t_end)
 
-    a0 = np.empty((dim, n))
-    acc = np.empty((dim, n))
-    sx = np.empty((dim, n))
-    sv = np.empty((dim, n))
-    nx = np.empty((dim, n))
-    nv = np.empty((dim, n))
-    ncx = np.empty((dim, n))
-    ncv = np.empty((dim, n))
-    v0 = np.empty((dim, n))
-    g = np.empty((7, dim, n))
-    csb = np.empty((7, dim, n))
-    p = np.empty(n)
-    q = np.empty(n)
 
     evaluations = 0
     rejected = 0
@@ -725,11 +748,11 @@ def advance(t, h, steps, state, model, work, vdep, t_end, tol, memory):
             tc = 0.0
         else:
             t, tc = _kahan(t, tc, dt)
-        b_done[:] = b
+        _copy3(b, b_done)
         if e_valid:
-            e_done[:] = e
+            _copy3(e, e_done)
         else:
-            e_done[:] = b  # no prediction was made for this step: no correction to carry
+            _copy3(b, e_done)  # no prediction was made for this step: no correction to carry
         dt_last = dt
         _predict(b_done, e_done, b, e, h / dt)
         e_valid = True
