@@ -408,6 +408,15 @@ class Simulation(DeclaresTerms):
         your own: ``engine.forces.dispatch.accelerations(sim.t, state, model, acc, work)``."""
         return self._particles.state(self._box), self._current_model()
 
+    def kepler_plan(self):
+        """whfast's or saba's plan for this simulation as it is now (the split of its force terms
+        into Kepler drifts and kicks, ``engine.integrators.wisdom_holman.plan``), to pass as
+        ``plan=`` to ``engine.integrators.advance`` with ``kernel_arguments()``."""
+        if self._integrator not in ("whfast", "saba"):
+            raise ValueError(f"kepler_plan: integrator is {self._integrator!r}; "
+                             "a plan is made for 'whfast' and 'saba' only")
+        return self._kepler_plan(*self.kernel_arguments())
+
     # -- time ------------------------------------------------------------------------
     def step(self, n=1):
         """Advance ``n`` steps in one compiled call (``n`` accepted steps for rk45).

@@ -529,6 +529,8 @@ def _corrector(table, sign, h, mode, t, jp, jv, state, kick_model, work, m, orde
                mu, center, acc, ja, kick_com, r, v, shifted, vdep, mo, xs, ad, massive, G):
     """The corrector (sign 1) or its inverse (sign -1): Z(a, b) = D(a) K(-b) D(-2a) K(b) D(a)
     for each row (a / h, b / h) of ``table``."""
+    if mode == ATTRACTOR and kick_model.kinds.shape[0] == 0:
+        return  # no interaction: every kick is zero, and each Z(a, b) the identity
     for row in range(table.shape[0]):
         a = table[row, 0] * h
         b = sign * table[row, 1] * h

@@ -110,7 +110,7 @@ def test_direct_and_dispatched_calls_give_identical_bits():
             sim.step(50)
         else:
             state, model = sim.kernel_arguments()
-            plan = sim._kepler_plan(state, model)
+            plan = sim.kepler_plan()
             t, _, done, _ = engine.integrators.advance("whfast", 0.0, 0.02, 50, state, model,
                                                         False, plan=plan, corrector=11)
             assert done == 50 and t == pytest.approx(1.0)
