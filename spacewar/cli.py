@@ -121,6 +121,10 @@ def build_parser():
     t.add_argument("--workers", type=_positive_int, default=None, help="worker processes (default: all cores)")
     t.add_argument("--json", action="store_true", help="print the full report as JSON")
     t.add_argument("--no-progress", action="store_true", help="no progress bar")
+    t.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="run the matches on a Dask cluster: its scheduler's address, or 'local' "
+                        "for a LocalCluster of this machine (default: $DASK_SCHEDULER_ADDRESS, "
+                        "else local processes); needs the [cluster] extra")
     _add_rules_options(t)
     _add_fault_options(t)
 
@@ -246,7 +250,8 @@ def _cmd_tournament(args):
     report, stats = run_tournament(
         bots, games=args.games, seed=args.seed, rounds=args.rounds, rules=_rules_from(args),
         workers=args.workers, progress=not args.no_progress and not args.json,
-        limits=_limits_from(args), max_faults=args.max_faults, isolation=args.isolation)
+        limits=_limits_from(args), max_faults=args.max_faults, isolation=args.isolation,
+        scheduler=args.scheduler)
     if args.json:
         print(json.dumps(report, sort_keys=True, indent=2))
     else:
@@ -330,10 +335,11 @@ def main(argv=None):
     args = build_parser().parse_args(argv)
     from .bots import BotLoadError
     from .replay import ReplayError
+    from engine.cluster import CodeMismatch
 
     try:
         return COMMANDS[args.command](args)
-    except (BotLoadError, ReplayError, ValueError) as exc:
+    except (BotLoadError, ReplayError, ValueError, CodeMismatch) as exc:
         print(f"spacewar {args.command}: error: {exc}", file=sys.stderr)
         return 2
     except ImportError as exc:

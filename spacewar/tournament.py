@@ -94,6 +94,11 @@ def _worker_start():
     die_with_parent()
 
 
+def warm_up_game():
+    """A cluster worker's warm-up (``engine.cluster.WarmWorker``): the game's kernels."""
+    _warm_up(Rules())
+
+
 def _warm_up(rules):
     """Compile (or load) the game's code here, once, before the workers start: workers then
     only read numba's cache instead of all compiling and writing it at the same time."""
@@ -127,11 +132,13 @@ def bradley_terry_elo(names, results, iterations=2000):
 
 def run_tournament(bots, games=10, seed=1, rounds=3, rules=None, workers=None, progress=True,
                    budget=DEFAULT_BUDGET, max_faults=DEFAULT_MAX_FAULTS, isolation="auto",
-                   limits=None):
+                   limits=None, scheduler=None):
     """Play the round robin; return ``(report, stats)``: the table and every match result
     (plain data), and the frames played and match seconds. ``limits`` (a
     ``spacewar.seats.Limits``) sets every budget of the bots; ``budget`` alone the per-action
-    one."""
+    one. ``scheduler``: a Dask scheduler's address, or ``"local"`` for a LocalCluster of this
+    machine (default: the ``DASK_SCHEDULER_ADDRESS`` variable, else local processes); the
+    report is the same either way (``spacewar.cluster_play``)."""
     bots = list(bots)
     if len(bots) < 2:
         raise ValueError(f"a tournament needs at least two bots, got {bots!r}")
@@ -153,6 +160,18 @@ def run_tournament(bots, games=10, seed=1, rounds=3, rules=None, workers=None, p
              batch_files)
             for matches, together in _jobs(schedule(bots, games, seed), isolation, batch_files)]
     total = sum(len(job[0]) for job in jobs)
+    from engine.cluster import scheduler_address
+
+    address = scheduler_address(scheduler)
+    if address is not None:
+        from .cluster_play import play_jobs
+
+        bar = _progress(total, progress)
+        try:
+            outcomes = play_jobs(address, bots, jobs, lambda done: bar.update(done))
+        finally:
+            bar.close()
+        return _report(bots, games, seed, rounds, rules, outcomes)
     if workers > 1:
         _warm_up(rules)
     bar = _progress(total, progress)
@@ -171,6 +190,10 @@ def run_tournament(bots, games=10, seed=1, rounds=3, rules=None, workers=None, p
                 bar.update(futures[future])
             outcomes = [outcome for f in futures for outcome in f.result()]
     bar.close()
+    return _report(bots, games, seed, rounds, rules, outcomes)
+
+
+def _report(bots, games, seed, rounds, rules, outcomes):
     matches = [r for r, _ in outcomes]
     frames = sum(r["steps"] for r in matches)
     wall = sum(t["wall_seconds"] for _, t in outcomes)

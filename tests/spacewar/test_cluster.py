@@ -1,0 +1,109 @@
+"""Tournaments on a Dask cluster (``spacewar.cluster_play``, ``engine.cluster``): the same JSON
+as local processes, bots from files (hostile ones included) sent as bytes, a worker killed
+mid-run changing nothing, a worker with other code refused."""
+import json
+import os
+import signal
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+distributed = pytest.importorskip("distributed")
+
+from engine import cluster  # noqa: E402
+from spacewar import cluster_play  # noqa: E402
+from spacewar.bots import BotLoadError  # noqa: E402
+from spacewar.tournament import run_tournament  # noqa: E402
+
+HOSTILE = str(Path(__file__).with_name("hostile_bots.py"))
+
+
+@pytest.fixture(scope="module")
+def dask_cluster():
+    cluster.warm_up(["spacewar.tournament:warm_up_game"])  # the workers then only load
+    with distributed.LocalCluster(n_workers=2, processes=True, threads_per_worker=1,
+                                  dashboard_address=":0") as local:
+        yield local
+
+
+def _json(report):
+    return json.dumps(report, sort_keys=True)
+
+
+def test_a_tournament_on_the_cluster_is_the_local_one_byte_for_byte(dask_cluster):
+    bots = ["chaser", "sniper", f"{HOSTILE}:ReducePayload", f"{HOSTILE}:ExitInAct"]
+    local, _ = run_tournament(bots, games=1, rounds=1, workers=1, progress=False)
+    remote, _ = run_tournament(bots, games=1, rounds=1, progress=False,
+                               scheduler=dask_cluster.scheduler_address)
+    assert _json(remote) == _json(local)
+    # the hostile bots played, lost their turns or forfeited, and were reported
+    rows = {row["bot"]: row for row in remote["table"]}
+    assert rows[f"{HOSTILE}:ExitInAct"]["forfeits"] + rows[f"{HOSTILE}:ExitInAct"]["faults"] > 0
+    assert rows[f"{HOSTILE}:ReducePayload"]["faults"] > 0
+
+
+def test_the_scheduler_variable_is_read(dask_cluster, monkeypatch):
+    monkeypatch.setenv(cluster.SCHEDULER_VARIABLE, dask_cluster.scheduler_address)
+    assert cluster.scheduler_address(None) == dask_cluster.scheduler_address
+    assert cluster.scheduler_address("tcp://elsewhere:8786") == "tcp://elsewhere:8786"
+    monkeypatch.delenv(cluster.SCHEDULER_VARIABLE)
+    assert cluster.scheduler_address(None) is None
+
+
+def test_a_worker_killed_mid_run_changes_nothing(dask_cluster):
+    bots = ["chaser", "sniper", "dodger", "random"]
+    local, _ = run_tournament(bots, games=3, rounds=1, workers=1, progress=False)
+    out = {}
+
+    def run():
+        try:
+            out["report"], _ = run_tournament(bots, games=3, rounds=1, progress=False,
+                                              scheduler=dask_cluster.scheduler_address)
+        except BaseException as exc:  # reported below, with the test's failure
+            out["error"] = repr(exc)
+
+    thread = threading.Thread(target=run)
+    thread.start()
+    # the scheduler runs in this process: read which worker is computing a task, and kill
+    # that worker's process (a second client in this process would share the run's loop)
+    scheduler = dask_cluster.scheduler
+    pids = {nanny.worker_address: nanny.process.process.pid
+            for nanny in dask_cluster.workers.values()}
+    killed = False
+    deadline = time.monotonic() + 120
+    while not killed and thread.is_alive() and time.monotonic() < deadline:
+        busy = [ts.processing_on.address for ts in list(scheduler.tasks.values())
+                if ts.state == "processing" and ts.processing_on is not None]
+        if busy and busy[0] in pids:
+            os.kill(pids[busy[0]], signal.SIGKILL)
+            killed = True
+        time.sleep(0.02)
+    thread.join(300)
+    assert killed, "no task was seen running: the test killed nothing"
+    assert "error" not in out, out["error"]
+    assert _json(out["report"]) == _json(local)
+
+
+def test_a_worker_with_other_code_is_refused(dask_cluster):
+    with cluster.Connection(dask_cluster.scheduler_address) as connection:
+        jobs = [([("chaser", "sniper", 1)], False, 1, {}, None, 1, "auto", frozenset())]
+        with pytest.raises(cluster.CodeMismatch, match="install the client's version"):
+            cluster.run_chunks(connection, cluster_play.play_chunk, [jobs],
+                               common=("0" * 64, {}))
+
+
+def test_module_bots_cannot_travel_and_forged_bytes_are_refused(tmp_path):
+    with pytest.raises(BotLoadError, match="is a module"):
+        cluster_play.bot_files(["chaser", "spacewar.bots.chaser:Chaser"])
+    with pytest.raises(ValueError, match="do not match its sha256"):
+        cluster_play._materialise("bot.py", b"print('other code')", "0" * 64)
+
+
+def test_chunks_keep_the_order_and_bound_their_size():
+    items = list(range(1000))
+    chunks = cluster.chunk(items, workers=2)
+    assert [x for c in chunks for x in c] == items
+    assert max(len(c) for c in chunks) <= 64 and len(chunks) >= 8
+    assert cluster.chunk([], 4) == []
