@@ -1,4 +1,4 @@
-"""The ``spacewar`` command: bots, match, tournament, replay, play, train."""
+"""The ``spacewar`` command: bots, match, tournament, league, replay, play, train."""
 import argparse
 import json
 import math
@@ -91,6 +91,10 @@ def _positive_int(text):
     return _int(text, 1, 1_000_000)
 
 
+def _non_negative_int(text):
+    return _int(text, 0, 1_000_000)
+
+
 def _seed(text):
     return _int(text, 0, 2**63 - 1)
 
@@ -127,6 +131,33 @@ def build_parser():
                         "else local processes); needs the [cluster] extra")
     _add_rules_options(t)
     _add_fault_options(t)
+
+    lg = sub.add_parser("league", **fmt, help="many bots, Swiss or sampled pairings, ratings with "
+                                               "uncertainty, resumable")
+    lg.add_argument("--bots", required=True,
+                    help="a directory of bot files (every class defining act in its *.py files, "
+                         "every *.npz policy) or comma-separated bots")
+    lg.add_argument("--rounds", type=_positive_int, required=True,
+                    help="league rounds: each bot meets one opponent a round")
+    lg.add_argument("--out", required=True, metavar="FILE",
+                    help="JSON results file, written after every round; an existing one of the "
+                         "same league is resumed (and extended to --rounds)")
+    lg.add_argument("--pairing", choices=("swiss", "sampled"), default="swiss",
+                    help="swiss: neighbours in the ratings so far; sampled: random")
+    lg.add_argument("--games", type=_positive_int, default=2,
+                    help="seeds per pairing, each played in both seat orders")
+    lg.add_argument("--seed", type=_seed, default=1)
+    lg.add_argument("--match-rounds", type=_positive_int, default=3, help="rounds of each match")
+    lg.add_argument("--bootstrap", type=_non_negative_int, default=200,
+                    help="bootstrap resamples for the Bradley-Terry intervals")
+    lg.add_argument("--workers", type=_positive_int, default=None,
+                    help="worker processes (default: all cores)")
+    lg.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                    help="run the matches on a Dask cluster (as for tournament)")
+    lg.add_argument("--json", action="store_true", help="print the results as JSON")
+    lg.add_argument("--no-progress", action="store_true", help="no progress bar")
+    _add_rules_options(lg)
+    _add_fault_options(lg)
 
     r = sub.add_parser("replay", **fmt, help="check a replay or render it to a GIF")
     r.add_argument("file")
@@ -264,6 +295,44 @@ def _cmd_tournament(args):
     return 0
 
 
+def _cmd_league(args):
+    import os
+
+    from .bots import bots_in
+    from .league import format_table, run_league
+
+    if os.path.isdir(args.bots):
+        bots, skipped = bots_in(args.bots)
+        for path, reason in skipped.items():
+            print(f"spacewar league: skipped {path}: {reason}", file=sys.stderr)
+    else:
+        bots = [b.strip() for b in args.bots.split(",") if b.strip()]
+    _check_policy_files(bots)
+
+    def report_round(results):
+        if not args.json and not args.no_progress:
+            from tqdm import tqdm
+
+            tqdm.write(f"round {results['rounds_played']} of {args.rounds} saved to {args.out}",
+                       file=sys.stderr)
+
+    results = run_league(
+        bots, args.rounds, args.out, games=args.games, pairing=args.pairing, seed=args.seed,
+        match_rounds=args.match_rounds, rules=_rules_from(args), workers=args.workers,
+        progress=not args.no_progress and not args.json, limits=_limits_from(args),
+        max_faults=args.max_faults, isolation=args.isolation, scheduler=args.scheduler,
+        bootstrap=args.bootstrap, on_round=report_round)
+    if args.json:
+        print(json.dumps(results, sort_keys=True, indent=1))
+    else:
+        matches = sum(len(r["matches"]) for r in results["rounds"])
+        print(f"League: {len(bots)} bots, {results['rounds_played']} {args.pairing} rounds, "
+              f"{matches} matches of {args.match_rounds} rounds, seed {args.seed}; "
+              f"results in {args.out}")
+        print(format_table(results))
+    return 0
+
+
 def _cmd_replay(args):
     from . import replay as replay_io
 
@@ -327,7 +396,7 @@ def _cmd_train(args):
     return 0
 
 
-COMMANDS = {"train": _cmd_train, "bots": _cmd_bots, "match": _cmd_match, "tournament": _cmd_tournament,
+COMMANDS = {"train": _cmd_train, "bots": _cmd_bots, "match": _cmd_match, "tournament": _cmd_tournament, "league": _cmd_league,
             "replay": _cmd_replay, "play": _cmd_play, "sandbox": _cmd_sandbox}
 
 

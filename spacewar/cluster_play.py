@@ -98,13 +98,29 @@ def play_chunk(jobs, fingerprint, files):
     return out
 
 
-def play_jobs(address, bots, jobs, progress):
-    """Every job's outcomes, in job order, played on the cluster at ``address``;
-    ``progress(matches)`` as tasks complete."""
-    files = bot_files(bots)
-    with cluster.Connection(address, warm=("spacewar.tournament:warm_up_game",)) as connection:
-        chunks = cluster.chunk(jobs, connection.workers())
-        results = cluster.run_chunks(
-            connection, play_chunk, chunks, common=(cluster.code_fingerprint(), files),
-            progress=lambda c: progress(sum(len(job[0]) for job in c)))
+class _GameConnection:
+    """A cluster connection with the run's bot files, ready to play jobs."""
+
+    def __init__(self, address, bots):
+        self.files = bot_files(bots)
+        self.connection = cluster.Connection(address, warm=("spacewar.tournament:warm_up_game",))
+
+    def close(self):
+        self.connection.close()
+
+
+def connect(address, bots):
+    """A connection to the cluster at ``address`` for matches among ``bots`` (their files
+    read and hashed once); ``close()`` it when done."""
+    return _GameConnection(address, bots)
+
+
+def play_jobs(connection, jobs, progress):
+    """Every job's outcomes, in job order, played on the cluster of ``connection``
+    (``connect``); ``progress(matches)`` as tasks complete."""
+    chunks = cluster.chunk(jobs, connection.connection.workers())
+    results = cluster.run_chunks(
+        connection.connection, play_chunk, chunks,
+        common=(cluster.code_fingerprint(), connection.files),
+        progress=lambda c: progress(sum(len(job[0]) for job in c)))
     return [outcome for chunk in results for outcomes in chunk for outcome in outcomes]

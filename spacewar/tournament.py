@@ -116,18 +116,25 @@ def bradley_terry_elo(names, results, iterations=2000):
         i, j = index[p1], index[p2]
         wins[i, j] += outcome
         wins[j, i] += 1.0 - outcome
+    elo = bradley_terry_fit(wins, iterations)
+    return {n: float(elo[index[n]]) for n in names}
+
+
+def bradley_terry_fit(wins, iterations=2000):
+    """Elo-scale Bradley-Terry ratings (an array) from ``wins[i, j]``, the games i won against
+    j (a draw half each way): Hunter's (2004) MM iteration, each bot also drawing once with
+    an anchor of strength 1 (1500)."""
     games = wins + wins.T
-    strength = np.ones(k)
+    strength = np.ones(wins.shape[0])
+    won = wins.sum(axis=1) + 0.5
     for _ in range(iterations):
-        # MM update with one virtual draw against an anchor of strength 1
-        numer = wins.sum(axis=1) + 0.5
         denom = (games / (strength[:, None] + strength[None, :])).sum(axis=1) + 1.0 / (strength + 1.0)
-        new = numer / denom
+        new = won / denom
         if np.allclose(new, strength, rtol=1e-12, atol=0):
             strength = new
             break
         strength = new
-    return {n: 1500.0 + 400.0 * math.log10(strength[index[n]]) for n in names}
+    return 1500.0 + 400.0 * np.log10(strength)
 
 
 def run_tournament(bots, games=10, seed=1, rounds=3, rules=None, workers=None, progress=True,
@@ -155,42 +162,78 @@ def run_tournament(bots, games=10, seed=1, rounds=3, rules=None, workers=None, p
     if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
         raise ValueError(f"workers must be an int >= 1, got {workers!r}")
     limits = Limits(budget=budget) if limits is None else limits
-    batch_files = batch_files_of(bots)
-    jobs = [(matches, together, rounds, rules.to_dict(), limits, max_faults, isolation,
-             batch_files)
-            for matches, together in _jobs(schedule(bots, games, seed), isolation, batch_files)]
-    total = sum(len(job[0]) for job in jobs)
-    from engine.cluster import scheduler_address
-
-    address = scheduler_address(scheduler)
-    if address is not None:
-        from .cluster_play import play_jobs
-
-        bar = _progress(total, progress)
-        try:
-            outcomes = play_jobs(address, bots, jobs, lambda done: bar.update(done))
-        finally:
-            bar.close()
-        return _report(bots, games, seed, rounds, rules, outcomes)
-    if workers > 1:
-        _warm_up(rules)
-    bar = _progress(total, progress)
-    outcomes = []
-    if workers == 1:
-        for job in jobs:
-            outcomes.extend(_play(job))
-            bar.update(len(job[0]))
-    else:
-        ctx = multiprocessing.get_context("spawn")
-        with concurrent.futures.ProcessPoolExecutor(max_workers=workers, mp_context=ctx,
-                                                    initializer=_worker_start) as pool:
-            futures = {pool.submit(_play, job): len(job[0]) for job in jobs}
-            for future in concurrent.futures.as_completed(futures):
-                future.result()  # surface worker errors early
-                bar.update(futures[future])
-            outcomes = [outcome for f in futures for outcome in f.result()]
-    bar.close()
+    jobs = make_jobs(schedule(bots, games, seed), rounds, rules, limits, max_faults, isolation,
+                     batch_files_of(bots))
+    bar = _progress(sum(len(job[0]) for job in jobs), progress)
+    try:
+        with MatchRunner(bots, rules, workers, scheduler) as runner:
+            outcomes = runner.play(jobs, bar.update)
+    finally:
+        bar.close()
     return _report(bots, games, seed, rounds, rules, outcomes)
+
+
+def make_jobs(schedule_, rounds, rules, limits, max_faults, isolation, batch_files):
+    """The work of a schedule: ``_jobs``' matches with everything a worker needs to play them."""
+    return [(matches, together, rounds, rules.to_dict(), limits, max_faults, isolation,
+             batch_files)
+            for matches, together in _jobs(schedule_, isolation, batch_files)]
+
+
+class MatchRunner:
+    """Where matches are played, kept open across calls (a league plays round after round):
+    in this process (``workers=1``), in a pool of ``workers`` local processes, or on the Dask
+    cluster at ``scheduler`` (an address, or ``"local"``; default: ``DASK_SCHEDULER_ADDRESS``,
+    else local). ``play(jobs, progress)`` gives every job's outcomes in job order whichever it
+    is, so the results are the same."""
+
+    def __init__(self, bots, rules, workers, scheduler=None):
+        from engine.cluster import scheduler_address
+
+        self.address = scheduler_address(scheduler)
+        self.bots, self.rules, self.workers = list(bots), rules, workers
+        self._pool = self._connection = None
+
+    def play(self, jobs, progress=lambda matches: None):
+        if self.address is not None:
+            return self._play_on_cluster(jobs, progress)
+        if self.workers == 1:
+            outcomes = []
+            for job in jobs:
+                outcomes.extend(_play(job))
+                progress(len(job[0]))
+            return outcomes
+        if self._pool is None:
+            _warm_up(self.rules)
+            ctx = multiprocessing.get_context("spawn")
+            self._pool = concurrent.futures.ProcessPoolExecutor(
+                max_workers=self.workers, mp_context=ctx, initializer=_worker_start)
+        futures = {self._pool.submit(_play, job): len(job[0]) for job in jobs}
+        for future in concurrent.futures.as_completed(futures):
+            future.result()  # surface worker errors early
+            progress(futures[future])
+        return [outcome for f in futures for outcome in f.result()]
+
+    def _play_on_cluster(self, jobs, progress):
+        from . import cluster_play
+
+        if self._connection is None:
+            self._connection = cluster_play.connect(self.address, self.bots)
+        return cluster_play.play_jobs(self._connection, jobs, progress)
+
+    def close(self):
+        if self._pool is not None:
+            self._pool.shutdown(cancel_futures=True)
+            self._pool = None
+        if self._connection is not None:
+            self._connection.close()
+            self._connection = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
 
 
 def _report(bots, games, seed, rounds, rules, outcomes):
@@ -244,14 +287,14 @@ class _NoBar:
         pass
 
 
-def _progress(total, enabled):
+def _progress(total, enabled, what="tournament"):
     if not enabled:
         return _NoBar()
     try:
         from tqdm import tqdm
     except ImportError:
         return _NoBar()
-    return tqdm(total=total, unit="match", desc="tournament", leave=False)
+    return tqdm(total=total, unit="match", desc=what, leave=False)
 
 
 def format_table(report):

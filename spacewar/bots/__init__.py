@@ -187,6 +187,82 @@ def _defines(line, attribute):
                                               (["="], [":"]))
 
 
+def _read_source(path):
+    """A bot file's bytes (at most ``MAX_SOURCE_BYTES``), or None for anything that is not a
+    readable regular file of that size (opened non-blocking: a FIFO is never waited on)."""
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_CLOEXEC)
+    except OSError:
+        return None
+    try:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            return None
+        with os.fdopen(fd, "rb", closefd=False) as f:
+            data = f.read(MAX_SOURCE_BYTES + 1)
+    except OSError:
+        return None
+    finally:
+        os.close(fd)
+    return data if len(data) <= MAX_SOURCE_BYTES else None
+
+
+def _top_level_classes(source):
+    """The names of the top-level ``class`` statements of ``source`` (bytes), in order,
+    read with the tokenizer (nothing parsed or run; the first error token ends the reading)."""
+    names, depth, line = [], 0, []
+    for token in tokenize.tokenize(io.BytesIO(source).readline):
+        kind, text = token.type, token.string
+        if kind == tokenize.ERRORTOKEN:
+            break
+        if kind == tokenize.INDENT:
+            depth += 1
+        elif kind == tokenize.DEDENT:
+            depth -= 1
+        elif kind in (tokenize.NEWLINE, tokenize.ENDMARKER):
+            if depth == 0 and len(line) >= 2 and line[0] == "class" and line[1].isidentifier():
+                names.append(line[1])
+            line = []
+        elif kind not in (tokenize.NL, tokenize.COMMENT, tokenize.ENCODING) and len(line) < 2:
+            line.append(text)
+    return list(dict.fromkeys(names))
+
+
+def bots_in(directory):
+    """The bots of a directory of submissions: ``(specs, skipped)``.
+
+    ``specs``: ``path/file.py:Class`` for every top-level class of every ``*.py`` file that
+    defines ``act`` or ``act_batch`` in its own body, and every ``*.npz`` policy file, sorted
+    by path then class. Found by reading the sources with the tokenizer: none of their code
+    runs here (a class that gets ``act`` from a base class is not found; name it on the command
+    line instead). ``skipped``: ``{path: reason}`` for the ``*.py`` files with no such class, or
+    that cannot be read (not a regular file, over ``MAX_SOURCE_BYTES``, not Python)."""
+    if not os.path.isdir(directory):
+        raise BotLoadError(f"bots directory {directory!r} is not a directory")
+    specs, skipped = [], {}
+    for name in sorted(os.listdir(directory)):
+        path = os.path.join(directory, name)
+        if name.lower().endswith(".npz") and os.path.isfile(path):
+            specs.append(path)
+            continue
+        if not name.endswith(".py") or name.startswith("."):
+            continue
+        source = _read_source(path)
+        if source is None:
+            skipped[path] = f"not a regular file of at most {MAX_SOURCE_BYTES} bytes"
+            continue
+        try:
+            found = [c for c in _top_level_classes(source)
+                     if _class_body_defines(source, c, "act")
+                     or _class_body_defines(source, c, "act_batch")]
+        except Exception as exc:  # whatever the tokenizer or a codec cookie raises
+            skipped[path] = f"cannot be read as Python ({type(exc).__name__})"
+            continue
+        if not found:
+            skipped[path] = "no top-level class defining act or act_batch"
+        specs += [f"{path}:{c}" for c in found]
+    return specs, skipped
+
+
 def _module_source(where):
     """The source file of module ``where`` (dotted), found as ``locate`` finds it, without
     importing anything."""

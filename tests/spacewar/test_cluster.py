@@ -107,3 +107,14 @@ def test_chunks_keep_the_order_and_bound_their_size():
     assert [x for c in chunks for x in c] == items
     assert max(len(c) for c in chunks) <= 64 and len(chunks) >= 8
     assert cluster.chunk([], 4) == []
+
+
+def test_a_league_on_the_cluster_writes_the_local_file_byte_for_byte(dask_cluster, tmp_path):
+    from spacewar.league import run_league
+
+    bots = ["chaser", "sniper", "dodger", "random", f"{HOSTILE}:ExitInAct"]
+    quick = dict(games=1, match_rounds=1, progress=False, bootstrap=20)
+    run_league(bots, 2, tmp_path / "local.json", workers=1, **quick)
+    run_league(bots, 2, tmp_path / "cluster.json", scheduler=dask_cluster.scheduler_address,
+               **quick)
+    assert (tmp_path / "cluster.json").read_bytes() == (tmp_path / "local.json").read_bytes()
