@@ -677,7 +677,7 @@ def machine():
 
 def run(quick=False, sections=None):
     sections = sections or ["direct", "small", "scaling", "terms", "startup", "spacewar", "batch",
-                            "learning", "planets"]
+                            "learning", "planets", "cluster"]
     repeats = 3 if quick else 7
     report = {"machine": machine(), "quick": quick}
     if "direct" in sections:
@@ -699,6 +699,10 @@ def run(quick=False, sections=None):
     if "planets" in sections:
         report["planets"] = bench_planets(20_000 if quick else 100_000,
                                           2e5 if quick else 1e6, repeats)
+    if "cluster" in sections:
+        from .bench_cluster import bench_cluster
+
+        report["cluster"] = bench_cluster(quick)
     return report
 
 
@@ -897,6 +901,12 @@ def format_report(r):
             lines.append(f"{row['method']:<24}{row['engine_us_per_step']:>16.2f}"
                          f"{row['rebound_us_per_step']:>17.2f}{row['time_over_rebound']:>16.2f}"
                          f"{row['relative_position_difference']:>15.1e}")
+    if "cluster" in r:
+        from .bench_cluster import format_cluster
+
+        lines.append("\n10. tournaments and sweeps on Dask (local processes against a "
+                     "LocalCluster)")
+        lines += format_cluster(r["cluster"])
     if targets(r):
         lines.append("\ntargets:")
         for name, measured, met in targets(r):
@@ -1042,6 +1052,11 @@ def format_markdown(r, command):
                 f"{row['rebound_us_per_step']:.2f} | {row['time_over_rebound']:.2f} | "
                 f"{row['relative_position_difference']:.1e} |" for row in pl["rows"].values()]
         out.append("")
+    if "cluster" in r:
+        from .bench_cluster import markdown_cluster
+
+        out += ["## 10. Tournaments and sweeps on Dask", ""] + markdown_cluster(r["cluster"])
+        out.append("")
     return "\n".join(out)
 
 
@@ -1053,7 +1068,7 @@ def main(argv=None):
     parser.add_argument("--markdown", metavar="FILE", help="also write the results as Markdown")
     parser.add_argument("--only", metavar="SECTIONS",
                         help="comma-separated: direct,small,scaling,terms,startup,spacewar,batch,"
-                             "learning,planets")
+                             "learning,planets,cluster")
     args = parser.parse_args(argv)
     # a bad output path fails now, not after minutes of benchmarks
     try:

@@ -118,3 +118,20 @@ def test_a_league_on_the_cluster_writes_the_local_file_byte_for_byte(dask_cluste
     run_league(bots, 2, tmp_path / "cluster.json", scheduler=dask_cluster.scheduler_address,
                **quick)
     assert (tmp_path / "cluster.json").read_bytes() == (tmp_path / "local.json").read_bytes()
+
+
+def test_a_validation_sweep_on_the_cluster_is_the_local_one(dask_cluster):
+    pytest.importorskip("rebound")
+    from validation import report
+    from validation.settings import LEVELS
+
+    untimed = ("crosscheck", "two_body", "energy_drift", "hard_cases")
+
+    def results(**where):
+        out = report.jsonable(report.collect(LEVELS["smoke"], progress=False, sections=untimed,
+                                             **where))
+        assert set(out) == {"meta", "timings", *untimed}
+        return json.dumps({k: v for k, v in out.items() if k not in ("meta", "timings")},
+                          sort_keys=True)
+
+    assert results(scheduler=dask_cluster.scheduler_address) == results(workers=1)
