@@ -76,11 +76,13 @@ def _local_specs(files):
     return local
 
 
-def play_chunk(jobs, fingerprint, files):
-    """A task: the outcomes of each job (``tournament._play``), with the client's bot names."""
+def play_chunk(task, fingerprint):
+    """A task: the outcomes of each job of ``task = (jobs, files)`` (``tournament._play``),
+    with the client's bot names; ``files`` holds the bots from files those jobs play."""
     cluster.check_code(fingerprint)
     from .tournament import _play
 
+    jobs, files = task
     local = _local_specs(files)
     back = {v: k for k, v in local.items()}
     out = []
@@ -96,6 +98,13 @@ def play_chunk(jobs, fingerprint, files):
                     result[key] = back.get(result[key], result[key])
         out.append(outcomes)
     return out
+
+
+def _task(jobs, files):
+    """A task's payload: its jobs and the files of just the bots they play (a league's task
+    carries a few bots' files, not every entrant's)."""
+    playing = {spec for job in jobs for match in job[0] for spec in match[:2]}
+    return jobs, {spec: f for spec, f in files.items() if spec in playing}
 
 
 class _GameConnection:
@@ -118,9 +127,8 @@ def connect(address, bots):
 def play_jobs(connection, jobs, progress):
     """Every job's outcomes, in job order, played on the cluster of ``connection``
     (``connect``); ``progress(matches)`` as tasks complete."""
-    chunks = cluster.chunk(jobs, connection.connection.workers())
+    tasks = [_task(c, connection.files) for c in cluster.chunk(jobs, connection.connection.workers())]
     results = cluster.run_chunks(
-        connection.connection, play_chunk, chunks,
-        common=(cluster.code_fingerprint(), connection.files),
-        progress=lambda c: progress(sum(len(job[0]) for job in c)))
+        connection.connection, play_chunk, tasks, common=(cluster.code_fingerprint(),),
+        progress=lambda task: progress(sum(len(job[0]) for job in task[0])))
     return [outcome for chunk in results for outcomes in chunk for outcome in outcomes]

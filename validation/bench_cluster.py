@@ -51,7 +51,7 @@ def _task_bytes(games, rounds):
 
     jobs = make_jobs(schedule(BOTS, games, 1), rounds, Rules(), Limits(), 25, "auto", frozenset())
     chunk = cluster.chunk(jobs, 2)[0]
-    args = (chunk, cluster.code_fingerprint(), {})
+    args = ((chunk, {}), cluster.code_fingerprint())
     result = cluster_play.play_chunk(*args)
     return {"matches": sum(len(job[0]) for job in chunk),
             "argument_bytes": len(pickle.dumps(args, protocol=5)),

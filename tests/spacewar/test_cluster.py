@@ -1,6 +1,7 @@
 """Tournaments on a Dask cluster (``spacewar.cluster_play``, ``engine.cluster``): the same JSON
 as local processes, bots from files (hostile ones included) sent as bytes, a worker killed
-mid-run changing nothing, a worker with other code refused."""
+mid-run changing nothing, a worker with other code refused; a league and a validation sweep on
+the cluster giving the local results."""
 import json
 import os
 import signal
@@ -90,8 +91,8 @@ def test_a_worker_with_other_code_is_refused(dask_cluster):
     with cluster.Connection(dask_cluster.scheduler_address) as connection:
         jobs = [([("chaser", "sniper", 1)], False, 1, {}, None, 1, "auto", frozenset())]
         with pytest.raises(cluster.CodeMismatch, match="install the client's version"):
-            cluster.run_chunks(connection, cluster_play.play_chunk, [jobs],
-                               common=("0" * 64, {}))
+            cluster.run_chunks(connection, cluster_play.play_chunk, [(jobs, {})],
+                               common=("0" * 64,))
 
 
 def test_module_bots_cannot_travel_and_forged_bytes_are_refused(tmp_path):
@@ -99,6 +100,13 @@ def test_module_bots_cannot_travel_and_forged_bytes_are_refused(tmp_path):
         cluster_play.bot_files(["chaser", "spacewar.bots.chaser:Chaser"])
     with pytest.raises(ValueError, match="do not match its sha256"):
         cluster_play._materialise("bot.py", b"print('other code')", "0" * 64)
+
+
+def test_a_task_carries_only_the_files_of_its_own_bots():
+    files = {f"{HOSTILE}:ExitInAct": ("h.py", b"x", "1"), f"{HOSTILE}:GcKiller": ("h.py", b"x", "1"),
+             "p.npz": ("p.npz", b"y", "2")}
+    jobs = [([("chaser", f"{HOSTILE}:ExitInAct", 5)], False)]
+    assert cluster_play._task(jobs, files) == (jobs, {f"{HOSTILE}:ExitInAct": files[f"{HOSTILE}:ExitInAct"]})
 
 
 def test_chunks_keep_the_order_and_bound_their_size():
