@@ -24,7 +24,7 @@ def solar(corrector=0, kernel="standard", dt=SOLAR_DT):
     return sim
 
 
-def rebound_solar(corrector, kernel, steps, dt=SOLAR_DT):
+def rebound_solar(corrector, kernel, steps, dt=SOLAR_DT, coordinates=None):
     p = problems.outer_solar_system()
     r = rebound.Simulation()
     r.G = p.G
@@ -35,6 +35,8 @@ def rebound_solar(corrector, kernel, steps, dt=SOLAR_DT):
     r.integrator.corrector = corrector
     r.integrator.kernel = "default" if kernel == "standard" else kernel
     r.integrator.safe_mode = 0
+    if coordinates is not None:
+        r.integrator.coordinates = coordinates
     if kernel == "lazy":
         r.gravity = "jacobi"  # REBOUND's lazy kernel kicks with the Jacobi interaction term
     r.steps(steps)
@@ -270,16 +272,7 @@ def test_democratic_heliocentric_is_rebounds_step_for_step():
     coordinate), while Jacobi coordinates differ from it by 3e-7."""
     sim = solar_democratic()
     sim.step(1000)
-    p = problems.outer_solar_system()
-    r = rebound.Simulation()
-    r.G = p.G
-    for m, x, v in zip(p.mass, p.pos, p.vel):
-        r.add(m=m, x=x[0], y=x[1], z=x[2], vx=v[0], vy=v[1], vz=v[2])
-    r.integrator = "whfast"
-    r.dt = SOLAR_DT
-    r.integrator.coordinates = "democraticheliocentric"
-    r.steps(1000)
-    theirs = np.array([[q.x, q.y, q.z] for q in r.particles])
+    theirs = rebound_solar(0, "standard", 1000, coordinates="democraticheliocentric")
     scale = np.abs(theirs).max()
     assert np.abs(sim.pos - theirs).max() / scale < 1e-12
     jacobi = solar()
