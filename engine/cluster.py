@@ -29,12 +29,19 @@ from pathlib import Path
 
 #: the environment variable read when no ``--scheduler`` is given (Dask's own name)
 SCHEDULER_VARIABLE = "DASK_SCHEDULER_ADDRESS"
+#: seconds a run waits for a scheduler's first worker before giving up
+WORKER_WAIT = 120
 _PACKAGES = ("engine", "spacewar", "validation")
 _FINGERPRINT = None
 
 
 class CodeMismatch(RuntimeError):
     """A worker runs other code than the client: the run cannot give the client's results."""
+
+
+class SchedulerUnreachable(ConnectionError):
+    """No Dask scheduler answered at the address given, or it has no worker."""
+
 
 
 def code_fingerprint():
@@ -99,7 +106,21 @@ class Connection:
                 n_workers=os.cpu_count() or 1, threads_per_worker=1, processes=True,
                 dashboard_address=":0")
             address = self.cluster.scheduler_address
-        self.client = distributed.Client(address)
+        try:
+            self.client = distributed.Client(address)  # waits distributed.comm.timeouts.connect
+        except (OSError, TimeoutError) as exc:
+            if self.cluster is not None:
+                self.cluster.close()
+            raise SchedulerUnreachable(
+                f"no Dask scheduler answered at {address!r} ({exc}); start "
+                "one with 'dask scheduler' (docs/cluster.md), or use --scheduler local") from None
+        try:
+            self.client.wait_for_workers(1, timeout=WORKER_WAIT)
+        except (TimeoutError, OSError):
+            self.close()
+            raise SchedulerUnreachable(
+                f"the Dask scheduler at {address!r} has had no worker for {WORKER_WAIT} s: start "
+                f"some with 'dask worker {address}' (docs/cluster.md)") from None
         self.client.register_plugin(WarmWorker(code_fingerprint(), tuple(warm)),
                                     name="nbody-spacewar-warm")
 

@@ -404,11 +404,11 @@ def main(argv=None):
     args = build_parser().parse_args(argv)
     from .bots import BotLoadError
     from .replay import ReplayError
-    from engine.cluster import CodeMismatch
+    from engine.cluster import CodeMismatch, SchedulerUnreachable
 
     try:
         return COMMANDS[args.command](args)
-    except (BotLoadError, ReplayError, ValueError, CodeMismatch) as exc:
+    except (BotLoadError, ReplayError, ValueError, CodeMismatch, SchedulerUnreachable) as exc:
         print(f"spacewar {args.command}: error: {exc}", file=sys.stderr)
         return 2
     except ImportError as exc:

@@ -1158,8 +1158,13 @@ def main(argv=None):
         check_outputs(args.out, sections)  # fail now, not after the runs
     except (OutputPathError, TypeError) as exc:
         parser.error(str(exc))
-    res = collect(level, workers=max(1, args.workers), progress=not args.no_progress,
-                  sections=sections, scheduler=args.scheduler)
+    from engine.cluster import CodeMismatch, SchedulerUnreachable
+
+    try:
+        res = collect(level, workers=max(1, args.workers), progress=not args.no_progress,
+                      sections=sections, scheduler=args.scheduler)
+    except (CodeMismatch, SchedulerUnreachable, ImportError) as exc:
+        parser.exit(2, f"python -m validation report: error: {exc}\n")
     write(args.out, res, level)
     print(f"wrote {os.path.join(args.out, 'report.md')} ({seconds(res['timings']['wall_s'])})",
           file=sys.stderr)

@@ -143,3 +143,22 @@ def test_a_validation_sweep_on_the_cluster_is_the_local_one(dask_cluster):
                           sort_keys=True)
 
     assert results(scheduler=dask_cluster.scheduler_address) == results(workers=1)
+
+
+def test_an_unreachable_scheduler_is_a_clear_error(capsys):
+    import dask
+
+    from spacewar.cli import main
+
+    with dask.config.set({"distributed.comm.timeouts.connect": "2s"}):
+        assert main(["tournament", "--bots", "chaser,sniper", "--games", "1", "--rounds", "1",
+                     "--scheduler", "tcp://127.0.0.1:9", "--no-progress"]) == 2
+    assert "no Dask scheduler answered at 'tcp://127.0.0.1:9'" in capsys.readouterr().err
+
+
+def test_a_scheduler_without_workers_is_a_clear_error(monkeypatch):
+    monkeypatch.setattr(cluster, "WORKER_WAIT", 2)
+    with distributed.LocalCluster(n_workers=0, dashboard_address=":0") as empty:
+        with pytest.raises(cluster.SchedulerUnreachable, match="has had no worker for 2 s"):
+            run_tournament(["chaser", "sniper"], games=1, rounds=1, progress=False,
+                           scheduler=empty.scheduler_address)
