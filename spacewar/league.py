@@ -40,7 +40,7 @@ import numpy as np
 from .match import DEFAULT_BUDGET, DEFAULT_MAX_FAULTS
 from .rules import Rules
 from .seats import Limits
-from .tournament import MatchRunner, _progress, batch_files_of, make_jobs
+from .tournament import MatchRunner, _progress, batch_files_of, make_jobs, match_record
 
 FORMAT = "spacewar-league"
 VERSION = 1
@@ -251,13 +251,6 @@ def _save(path, results):
     atomic_write(path, json.dumps(results, sort_keys=True, indent=1) + "\n")
 
 
-def _match_record(result):
-    return {"p1": result["bots"][0], "p2": result["bots"][1], "seed": result["seed"],
-            "winner": result["winner"], "score": result["score"], "steps": result["steps"],
-            "forfeit": result["forfeit"], "forfeits": result["forfeits"],
-            "faults": [result["faults"][0]["total"], result["faults"][1]["total"]]}
-
-
 def _state_after(config, rounds):
     """``(standings, met, byes)`` after ``rounds``: the pairing's inputs for the next round."""
     met, byes = {}, {}
@@ -335,7 +328,7 @@ def run_league(bots, rounds, out, games=2, pairing="swiss", seed=1, match_rounds
                                  limits, max_faults, isolation, batch_files)
                 outcomes = runner.play(jobs, bar.update)
                 done = done + [{"round": index + 1, "pairs": [list(p) for p in pairs],
-                                "bye": bye, "matches": [_match_record(r) for r, _ in outcomes]}]
+                                "bye": bye, "matches": [match_record(r) for r, _ in outcomes]}]
                 results = _results(config, done, _table(config, done, 0))
                 _save(out, results)
                 if on_round is not None:

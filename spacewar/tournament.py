@@ -244,12 +244,17 @@ def _report(bots, games, seed, rounds, rules, outcomes):
     return {
         "bots": bots, "games_per_pairing": games, "seed": int(seed), "rounds": int(rounds),
         "rules": rules.to_dict(), "table": table,
-        "matches": [{"p1": r["bots"][0], "p2": r["bots"][1], "seed": r["seed"],
-                     "winner": r["winner"], "score": r["score"], "steps": r["steps"],
-                     "forfeit": r["forfeit"], "forfeits": r["forfeits"],
-                     "faults": [r["faults"][0]["total"], r["faults"][1]["total"]]}
-                    for r in matches],
+        "matches": [match_record(r) for r in matches],
     }, {"frames": frames, "match_seconds": wall}
+
+
+def match_record(result):
+    """A match's line in a tournament's or a league's results: a match result cut to plain
+    data (fault totals, no wall-clock figure)."""
+    return {"p1": result["bots"][0], "p2": result["bots"][1], "seed": result["seed"],
+            "winner": result["winner"], "score": result["score"], "steps": result["steps"],
+            "forfeit": result["forfeit"], "forfeits": result["forfeits"],
+            "faults": [result["faults"][0]["total"], result["faults"][1]["total"]]}
 
 
 def _table(bots, matches):

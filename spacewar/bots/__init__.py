@@ -126,19 +126,12 @@ def declares_act_batch(spec):
     try:
         where, class_name = _split(spec)
         path = os.path.abspath(where) if _is_file_spec(where) else _module_source(where)
-        if path is None or not path.endswith(".py"):
-            return False
-        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_CLOEXEC)
-        try:
-            if not stat.S_ISREG(os.fstat(fd).st_mode):
-                return False  # a FIFO, a device, a directory: never read
-            with os.fdopen(fd, "rb", closefd=False) as f:
-                data = f.read(MAX_SOURCE_BYTES + 1)
-        finally:
-            os.close(fd)
     except (BotLoadError, OSError, ImportError, ValueError):
         return False
-    if len(data) > MAX_SOURCE_BYTES:
+    if path is None or not path.endswith(".py"):
+        return False
+    data = _read_source(path)  # None for a FIFO, a device, a directory, an oversized file
+    if data is None:
         return False
     try:
         return _class_body_defines(data, class_name, "act_batch")
