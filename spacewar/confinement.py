@@ -38,6 +38,7 @@ UNSHARE_FLAGS = ("--user", "--map-root-user", "--pid", "--fork", "--kill-child",
                  "--ipc", "--uts", "--mount-proc")
 _PR_SET_PDEATHSIG, _PR_CAPBSET_DROP = 1, 24
 _MS_NOSUID, _MS_NODEV, _MS_NOEXEC = 2, 4, 8
+_SCRATCH_INODES = 4096  # files and directories a bot's scratch tmpfs may hold
 
 #: system calls a bot never needs (each fails with EPERM); missing ones on an arch are skipped
 DENIED_SYSCALLS = (
@@ -181,7 +182,9 @@ def confine(config):
         layers.append("namespaces (user, pid, net, ipc, uts, mount)")
         if _mount_scratch(libc, config["scratch"], config["scratch_mb"]):
             layers.append(f"scratch tmpfs {config['scratch_mb']} MiB")
-    _copy_compiled_code(config.get("numba_cache"), config["scratch"])
+    _copy_compiled_code(config.get("numba_cache"), config["scratch"],
+                        budget_bytes=int(config["scratch_mb"]) * (1 << 20) // 2,
+                        budget_files=_SCRATCH_INODES // 4)
     os.chdir(config["scratch"])
     _limit_resources(config)
     layers.append("rlimits")
@@ -205,22 +208,52 @@ def confine(config):
     return layers
 
 
-def _copy_compiled_code(sources, scratch):
-    """A copy of the engine's and the game's compiled code in the scratch directory (numba
-    loads its cache only from a writable directory), so a bot using the engine's kernels does
-    not compile them."""
-    for source in sources or ():
-        if not os.path.isdir(source):
-            continue
+def _copy_compiled_code(pairs, scratch, budget_bytes, budget_files):
+    """A copy of this checkout's compiled game and engine code in the scratch directory
+    (numba loads its cache only from a writable directory), so a bot using the game's or the
+    engine's kernels does not compile them.
+
+    ``pairs`` are ``(source directory, destination relative to scratch/numba)``. A directory
+    is copied whole or not at all, and only while the copies stay within the budgets (a
+    share of the scratch tmpfs's bytes and inodes: the bot's own files need the rest). Each
+    file is written under a temporary name and renamed, data files before the index: a copy
+    cut short by a full disk leaves no truncated file for numba to trip over (an index entry
+    whose data file is missing only means a compile)."""
+    used_bytes = used_files = 0
+    for source, relative in pairs or ():
         try:
-            shutil.copytree(source, os.path.join(scratch, "numba", os.path.basename(source)))
+            names = sorted(os.listdir(source), key=lambda n: (n.endswith(".nbi"), n))
+            size = sum(os.path.getsize(os.path.join(source, n)) for n in names)
         except OSError:
-            pass  # no room: the bot compiles what it uses
+            continue
+        if used_bytes + size > budget_bytes or used_files + len(names) + 1 > budget_files:
+            continue
+        used_bytes, used_files = used_bytes + size, used_files + len(names) + 1
+        target = os.path.join(scratch, "numba", relative)
+        try:
+            os.makedirs(target, exist_ok=True)
+            for name in names:
+                _copy_whole(os.path.join(source, name), os.path.join(target, name))
+        except OSError:
+            return  # no room after all: the bot compiles what it uses
+
+
+def _copy_whole(source, target):
+    part = target + ".part"
+    try:
+        shutil.copyfile(source, part)
+        os.replace(part, target)
+    except OSError:
+        try:
+            os.unlink(part)
+        except OSError:
+            pass
+        raise
 
 
 def _mount_scratch(libc, path, size_mb):
     """A private tmpfs over the scratch directory: bounded in size and inodes, no exec."""
-    options = f"size={int(size_mb)}m,nr_inodes=4096,mode=0700".encode()
+    options = f"size={int(size_mb)}m,nr_inodes={_SCRATCH_INODES},mode=0700".encode()
     flags = _MS_NOSUID | _MS_NODEV | _MS_NOEXEC
     return libc.mount(b"tmpfs", os.fsencode(path), b"tmpfs", flags, options) == 0
 

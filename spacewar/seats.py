@@ -618,11 +618,36 @@ class BatchProcessSeat(ProcessSeat):
 
 @functools.lru_cache(maxsize=None)
 def _compiled_code_dirs():
-    """The engine's and the game's compiled-code directories (named by hashes of their
-    sources: found once)."""
+    """The directories of this checkout's compiled game and engine code, as
+    ``(source, destination relative to the bot's cache)`` pairs, the game's first (what a bot
+    most likely runs). A package's cache directory also holds the code compiled for every
+    other checkout of the same sources (numba names a subdirectory after each source
+    directory's absolute path): only this checkout's subdirectories are the bot's to copy."""
     from engine.cache import cache_dir
 
-    return [cache_dir("engine"), cache_dir("spacewar")]
+    try:  # numba's own naming of the subdirectories (not public: a later numba may move it)
+        from numba.core.caching import _CacheLocator
+    except ImportError:
+        return []  # nothing copied: a bot compiles what it uses
+    pairs = []
+    for package in ("spacewar", "engine"):
+        base = cache_dir(package)
+        for source_dir in _package_dirs(os.path.join(_PROJECT_ROOT, package)):
+            sub = _CacheLocator.get_suitable_cache_subpath(os.path.join(source_dir, "x.py"))
+            if os.path.isdir(os.path.join(base, sub)):
+                pairs.append((os.path.join(base, sub),
+                              os.path.join(os.path.basename(base), sub)))
+    return pairs
+
+
+def _package_dirs(root):
+    """``root`` and its subpackage directories, in a fixed order."""
+    found = [root]
+    for name in sorted(os.listdir(root)):
+        path = os.path.join(root, name)
+        if os.path.isfile(os.path.join(path, "__init__.py")):
+            found.extend(_package_dirs(path))
+    return found
 
 
 _DIR_PREFIX = "spacewar-bot-"

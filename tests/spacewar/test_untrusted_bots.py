@@ -552,3 +552,66 @@ def test_an_answer_sent_ahead_of_its_question_is_a_breach():
 def test_no_system_v_shared_memory():
     result = play(f"{HOSTILE}:SharedMemoryHog")
     assert "shm: BLOCKED errno 1" in result["output"][0]["text"]
+
+
+def test_a_bot_copies_only_this_checkout_s_compiled_code(tmp_path, monkeypatch):
+    """The compiled-code directories of the same sources hold a subdirectory for every checkout
+    that compiled them (numba names it after the source directory's path); a bot's scratch gets
+    this checkout's only, else a few other checkouts fill its tmpfs (the bot then finds its
+    copies cut short)."""
+    import hashlib
+
+    from engine.cache import cache_dir
+    from spacewar import seats
+
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
+    here = os.path.join(seats._PROJECT_ROOT, "spacewar")
+    elsewhere = "/elsewhere/checkout/spacewar"
+    mine, other = (os.path.join(cache_dir("spacewar"), "spacewar_" + hashlib.sha1(
+        path.encode()).hexdigest()) for path in (here, elsewhere))
+    for directory in (mine, other):
+        os.makedirs(directory)
+        with open(os.path.join(directory, "learning.f-1.py311.nbi"), "wb") as f:
+            f.write(b"index")
+    pairs = seats._compiled_code_dirs.__wrapped__()
+    assert [source for source, _ in pairs] == [mine]
+    assert pairs[0][1] == os.path.relpath(mine, str(tmp_path))
+
+
+def test_compiled_code_is_copied_whole_within_its_budget_or_not_at_all(tmp_path, monkeypatch):
+    import shutil
+
+    from spacewar.confinement import _copy_compiled_code
+
+    pairs = []
+    for name, sizes in (("a", [300, 200]), ("b", [600]), ("c", [100, 100])):
+        source = tmp_path / "cache" / name
+        source.mkdir(parents=True)
+        for i, size in enumerate(sizes):
+            (source / f"f{i}.nbc").write_bytes(b"x" * size)
+        (source / "f.nbi").write_bytes(b"i" * 10)
+        pairs.append((str(source), f"pkg/{name}"))
+    scratch = tmp_path / "scratch"
+    scratch.mkdir()
+    _copy_compiled_code(pairs, str(scratch), budget_bytes=800, budget_files=100)
+    copied = sorted(p.relative_to(scratch).as_posix() for p in scratch.rglob("*") if p.is_file())
+    assert copied == ["numba/pkg/a/f.nbi", "numba/pkg/a/f0.nbc", "numba/pkg/a/f1.nbc",
+                      "numba/pkg/c/f.nbi", "numba/pkg/c/f0.nbc", "numba/pkg/c/f1.nbc"]
+
+    # a disk that fills during a copy leaves no truncated file (numba would fail to read a
+    # truncated index; a missing one only means a compile), and the bot still starts
+    real = shutil.copyfile
+
+    def filling(source, target):
+        if os.path.basename(source) == "f1.nbc":
+            with open(target, "wb") as f:
+                f.write(b"x" * 10)
+            raise OSError(28, "No space left on device")
+        return real(source, target)
+
+    monkeypatch.setattr(shutil, "copyfile", filling)
+    full = tmp_path / "full"
+    full.mkdir()
+    _copy_compiled_code(pairs, str(full), budget_bytes=10_000, budget_files=100)
+    left = sorted(p.relative_to(full).as_posix() for p in full.rglob("*") if p.is_file())
+    assert left == ["numba/pkg/a/f0.nbc"]
