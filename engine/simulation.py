@@ -21,7 +21,7 @@ from .integrators import wisdom_holman
 from .particles import Particles
 from .space import check_box
 from .state import INVALID_FIELDS, first_invalid
-from .units import UnitSystem, strip_without_units
+from .units import Readouts, UnitSystem, strip_without_units
 
 _MAX_STEPS = MAX_STEPS
 
@@ -240,8 +240,25 @@ class Simulation(DeclaresTerms):
 
     @property
     def time(self):
-        """The time as an astropy Quantity in the simulation's units (the float ``t`` without)."""
+        """The time as an astropy Quantity in the simulation's units (the float ``t`` without),
+        so that ``sim.integrate(sim.time + 5 * u.yr)`` reads as it should; settable like ``t``."""
         return self._t if self._units is None else self._units.to_quantity(self._t, "time")
+
+    @time.setter
+    def time(self, value):
+        self.t = value
+
+    @property
+    def quantities(self):
+        """Every read-out as an astropy Quantity in the simulation's units: ``time``, ``dt``,
+        ``G``, ``box``, ``pos``, ``vel``, ``mass``, ``energy``, ``kinetic_energy``,
+        ``potential_energy``, ``momentum``, ``angular_momentum``, ``center_of_mass``
+        (``engine.units.Readouts``). A simulation without units has none to give."""
+        if self._units is None:
+            raise ValueError("the simulation has no units, so its read-outs are plain code-unit "
+                             "floats; create it with Simulation(units=(length, time, mass)) "
+                             "to read them as Quantities")
+        return Readouts(self, self._units)
 
     # -- particles -------------------------------------------------------------------
     @property

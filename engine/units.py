@@ -86,6 +86,51 @@ class UnitSystem:
         return f"UnitSystem(length={self.length}, time={self.time}, mass={self.mass})"
 
 
+class Readouts:
+    """A simulation's read-outs as astropy Quantities in its units (``sim.quantities``)::
+
+        sim = Simulation(dim=3, units=("AU", "yr", "Msun"))
+        ...
+        sim.quantities.energy.to(u.J)        # the total energy
+        sim.quantities.pos[1]                # a particle's position, in AU
+        sim.integrate(sim.time + 5 * u.yr)   # ``sim.time`` is the time as a Quantity
+
+    Each attribute is read when asked for (a copy: writing into a Quantity never changes the
+    simulation; change the state through ``sim.pos``, ``sim.vel`` or ``add``)."""
+
+    #: attribute -> (what it reads from the simulation, its kind in DIMENSIONS)
+    VALUES = {"time": ("t", "time"), "dt": ("dt", "time"), "G": ("G", "G"),
+              "box": ("box", "length"), "pos": ("pos", "length"), "vel": ("vel", "velocity"),
+              "mass": ("mass", "mass")}
+    DIAGNOSTICS = {"energy": "energy", "kinetic_energy": "energy", "potential_energy": "energy",
+                   "momentum": "momentum", "angular_momentum": "angular_momentum"}
+
+    def __init__(self, sim, units):
+        self._sim = sim
+        self._units = units
+
+    def __getattr__(self, name):
+        import numpy as np
+
+        if name in self.VALUES:
+            source, kind = self.VALUES[name]
+            return self._units.to_quantity(np.array(getattr(self._sim, source)), kind)
+        if name in self.DIAGNOSTICS:
+            return self._units.to_quantity(getattr(self._sim, name)(), self.DIAGNOSTICS[name])
+        if name == "center_of_mass":
+            pos, vel = self._sim.center_of_mass()
+            return (self._units.to_quantity(pos, "length"),
+                    self._units.to_quantity(vel, "velocity"))
+        raise AttributeError(f"no read-out {name!r}; there are: "
+                             f"{', '.join([*self.VALUES, *self.DIAGNOSTICS, 'center_of_mass'])}")
+
+    def __dir__(self):
+        return [*self.VALUES, *self.DIAGNOSTICS, "center_of_mass"]
+
+    def __repr__(self):
+        return f"<read-outs in {self._units!r}>"
+
+
 def strip_without_units(value, field):
     """Refuse a Quantity when the simulation has no units (its meaning would be ambiguous)."""
     if is_quantity(value):
@@ -94,4 +139,4 @@ def strip_without_units(value, field):
     return value
 
 
-__all__ = ["UnitSystem", "DIMENSIONS", "is_quantity"]
+__all__ = ["UnitSystem", "Readouts", "DIMENSIONS", "is_quantity"]

@@ -49,7 +49,10 @@ class Rules:
     angular_momentum: bool = False
     single_shot: bool = False
     # the star
-    star_mu: float = 2.5e-7  # heavy star's G M in arena^3 / frame^2; light is a quarter
+    # the heavy star's G M in arena^3 / frame^2, whatever ``star`` says: the one in play is
+    # ``effective_star_mu`` (a quarter of it for a light star, 0 without one), which the
+    # observations, ``in_play()`` and the repr show
+    star_mu: float = 2.5e-7
     star_capture: float = 8 * POINT
     # ships
     turn_rate: float = 2.0 * math.pi / 100.0  # rad per frame: a full turn in 100 frames
@@ -122,6 +125,26 @@ class Rules:
     @property
     def torpedoes_feel_star(self):
         return self.mode == "newtonian"
+
+    def in_play(self):
+        """Every number as the game uses it: the fields, with ``star_mu`` the G M of the star
+        in play (``effective_star_mu``: 0 with ``star="none"``) and whether torpedoes feel it.
+        ``to_dict`` keeps the stored fields (replays and ``from_dict`` round-trip them)."""
+        values = self.to_dict()
+        values["star_mu"] = self.effective_star_mu
+        values["torpedoes_feel_star"] = self.torpedoes_feel_star and self.effective_star_mu > 0
+        return values
+
+    def __repr__(self):
+        """The dataclass repr, with the star's G M in play beside the stored heavy-star value
+        when they differ (``Rules(star="none")`` plays without gravity from the star)."""
+        parts = []
+        for f in dataclasses.fields(self):
+            text = f"{f.name}={getattr(self, f.name)!r}"
+            if f.name == "star_mu" and self.effective_star_mu != self.star_mu:
+                text += f" [heavy star's; in play: {self.effective_star_mu!r}]"
+            parts.append(text)
+        return f"Rules({', '.join(parts)})"
 
     def replace(self, **changes):
         return dataclasses.replace(self, **changes)

@@ -40,3 +40,19 @@ def test_no_file_cites_paths_outside_the_repository():
                 hits.append(f"{path.relative_to(ROOT)}:{number}: {line.strip()}")
     assert not hits, "cite the original source instead of a file outside the repository:\n" + \
         "\n".join(hits)
+
+
+def test_nothing_refers_to_the_project_s_issue_numbers():
+    """A reader of the code, the docs or the program's output has no access to the tracker the
+    work was planned in: say what a thing is, not which ticket asked for it."""
+    import re
+
+    # spelled in pieces so that this file does not match itself
+    pattern = re.compile(r"\bissues?" + r"\s*#?\d+", re.IGNORECASE)
+    hits = []
+    for path in _repository_files():
+        text = path.read_text(encoding="utf-8", errors="replace")
+        for number, line in enumerate(text.splitlines(), 1):
+            if pattern.search(line):
+                hits.append(f"{path.relative_to(ROOT)}:{number}: {line.strip()}")
+    assert not hits, "internal references:\n" + "\n".join(hits)

@@ -1,7 +1,29 @@
 """``python -m validation report --out DIR [--quick]`` | ``python -m validation bench ...`` |
 ``python -m validation advise --problem NAME --error E [--t-end T]``"""
 import argparse
+import importlib
 import sys
+
+#: the modules each command needs beyond the core install, and the extra that has them
+NEEDS = {"report": ("rebound", "matplotlib"), "bench": ("rebound",), "advise": ()}
+EXTRA = "validation"
+
+
+def missing_modules(command):
+    """The modules ``command`` needs that cannot be imported here."""
+    missing = []
+    for name in NEEDS[command]:
+        try:
+            importlib.import_module(name)
+        except ImportError:
+            missing.append(name)
+    return missing
+
+
+def _missing_message(command, missing):
+    return (f"python -m validation {command} needs {' and '.join(missing)}, from the "
+            f"[{EXTRA}] extra: pip install 'nbody-spacewar[{EXTRA}]' (in a checkout: "
+            f"pip install -e '.[{EXTRA}]')")
 
 
 def main(argv=None):
@@ -21,6 +43,10 @@ def main(argv=None):
         parser.print_help()
         return 2
     command, rest = argv[0], argv[1:]
+    missing = [] if {"-h", "--help"} & set(rest) else missing_modules(command)
+    if missing:
+        print(_missing_message(command, missing), file=sys.stderr)
+        return 2
     if command == "report":
         from . import report
         return report.main(rest)

@@ -1067,8 +1067,8 @@ def main(argv=None):
     parser.add_argument("--json", metavar="FILE", help="also write the results as JSON")
     parser.add_argument("--markdown", metavar="FILE", help="also write the results as Markdown")
     parser.add_argument("--only", metavar="SECTIONS",
-                        help="comma-separated: direct,small,scaling,terms,startup,spacewar,batch,"
-                             "learning,planets,cluster")
+                        help="comma-separated sections (default: every one): direct,small,"
+                             "scaling,terms,startup,spacewar,batch,learning,planets,cluster")
     args = parser.parse_args(argv)
     # a bad output path fails now, not after minutes of benchmarks
     try:

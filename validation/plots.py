@@ -40,8 +40,33 @@ def label(method):
     return name if code == "engine" else f"REBOUND {name}"
 
 
-def _style(method):
-    return STYLE.get(method, ("gray", ":", "."))
+#: colours for methods missing from STYLE, and line styles for a method's further settings
+SPARE_COLOURS = ("tab:gray", "darkorange", "steelblue", "seagreen", "sienna", "slateblue",
+                 "olivedrab", "indianred")
+LINE_STYLES = ("-", "--", ":", "-.")
+
+
+def line_styles(keys):
+    """A distinct ``(colour, line style, marker)`` for each ``(method, setting)`` key, in order.
+
+    A method's first key gets its colour from ``STYLE`` (a method missing there gets the next
+    spare colour); each further setting of the same method keeps the colour and takes the next
+    line style, so two lines of one method (Euler at two step sizes) are never drawn alike."""
+    styles, spare, used = {}, iter(SPARE_COLOURS * 4), {}
+    for key in keys:
+        if key in styles:
+            continue
+        method = key[0]
+        if method not in used:
+            colour, ls, marker = STYLE.get(method) or (next(spare), "-", ".")
+            used[method] = [colour, marker, [ls]]
+            styles[key] = (colour, ls, marker)
+            continue
+        colour, marker, taken = used[method]
+        ls = next((s for s in LINE_STYLES if s not in taken), LINE_STYLES[len(taken) % 4])
+        taken.append(ls)
+        styles[key] = (colour, ls, marker)
+    return styles
 
 
 def _save(fig, path):
@@ -88,9 +113,10 @@ def two_body_convergence(section, path, checkpoint_index=1):
                 continue
             point = (run["steps_per_orbit"], max(err, 1e-17))
             by_method.setdefault(run["method"], []).append(point)
+        styles = line_styles([(method, "") for method in by_method])
         for method, pts in by_method.items():
             pts.sort()
-            c, ls, mk = _style(method)
+            c, ls, mk = styles[method, ""]
             ax.loglog(*zip(*pts), ls=ls, marker=mk, color=c, label=label(method), ms=4)
         ax.set_title(f"{entry['title']}: after {cp} P")
         ax.set_xlabel("steps per P")
@@ -108,14 +134,15 @@ def two_body_growth(section, path, steps_per_orbit):
         entry = section[key]
         tols = sorted({r["tolerance"] for r in entry["runs"] if "tolerance" in r})
         mid_tol = tols[len(tols) // 2] if tols else None
-        for run in entry["runs"]:
-            if run.get("steps_per_orbit") != steps_per_orbit and run.get("tolerance") != mid_tol:
-                continue
+        drawn = [run for run in entry["runs"] if run.get("steps_per_orbit") == steps_per_orbit
+                 or run.get("tolerance") == mid_tol]
+        styles = line_styles([(run["method"], run.get("tolerance")) for run in drawn])
+        for run in drawn:
             pts = [(t, max(e, 1e-17)) for t, e in zip(entry["checkpoints"], run["pos_err_kepler"])
                    if e is not None]
             if not pts:
                 continue
-            c, ls, mk = _style(run["method"])
+            c, ls, mk = styles[run["method"], run.get("tolerance")]
             name = label(run["method"]) + (f" tol {mid_tol:g}" if "tolerance" in run else "")
             ax.loglog(*zip(*pts), ls=ls, marker=mk, color=c, label=name, ms=4)
         ias = entry["ias15_vs_kepler"]["pos"]
@@ -135,12 +162,13 @@ def energy_drift(section, path):
     for ax, key in zip(axes, keys):
         entry = section[key]
         unit = entry["time_unit"]
+        styles = line_styles([(run["method"], run["setting"]) for run in entry["runs"]])
         for run in entry["runs"]:
             t = np.asarray(run["t"], dtype=float) / unit
             e = np.maximum(np.asarray(run["err"], dtype=float), 1e-17)
             if t.size == 0:
                 continue
-            c, ls, mk = _style(run["method"])
+            c, ls, mk = styles[run["method"], run["setting"]]
             slope = run["growth_exponent"]
             tag = "" if slope is None else f" (slope {0.0 if abs(slope) < 0.005 else slope:.2f})"
             ax.loglog(t, e, ls=ls, color=c, label=f"{label(run['method'])}, {run['setting']}{tag}",
@@ -157,17 +185,27 @@ def energy_drift(section, path):
 WP_ERROR_CAP = 1e2
 
 
-def work_precision(entry, path):
-    fig, axes = plt.subplots(1, 2, figsize=(12.5, 4.8), layout="constrained")
-    metric = entry["metric"]
+def work_precision_lines(entry):
+    """Each method's drawable runs (finished, error at most ``WP_ERROR_CAP``), in order of
+    cost (force evaluations, then wall time): a line follows the work done, whatever order
+    the sweep ran its settings in (an adaptive method's tolerances, a fixed step's counts)."""
     by_method = {}
     for run in entry["runs"]:
         if run.get("error") is None or not run["error"] <= WP_ERROR_CAP:
             continue
         by_method.setdefault(run["method"], []).append(run)
+    for runs in by_method.values():
+        runs.sort(key=lambda r: (r["evaluations"], r["time_s"]))
+    return by_method
+
+
+def work_precision(entry, path):
+    fig, axes = plt.subplots(1, 2, figsize=(12.5, 4.8), layout="constrained")
+    metric = entry["metric"]
+    by_method = work_precision_lines(entry)
+    styles = line_styles([(method, "") for method in by_method])
     for method, runs in by_method.items():
-        runs.sort(key=lambda r: r["evaluations"])  # the sweep's own order: cost
-        c, ls, mk = _style(method)
+        c, ls, mk = styles[method, ""]
         err = [max(r["error"], 1e-17) for r in runs]
         axes[0].loglog(err, [r["time_s"] for r in runs], ls=ls, marker=mk, color=c,
                        label=label(method), ms=4)

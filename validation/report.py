@@ -696,7 +696,7 @@ def section_versus(sec):
         "level over the wall time of the fastest REBOUND run that reaches it (any method of "
         "either code; both picked from the sweeps, then timed again side by side, alternating, "
         "in this process: the median of the per-repetition ratios). Below 1 the engine is "
-        "faster; bold: REBOUND is faster. The goal (issue 12) is at most 1 everywhere.")
+        "faster; bold: REBOUND is faster. The goal is at most 1 everywhere: the engine's best at least as fast as REBOUND's best.")
     lines.append("")
     lines.append(table(["problem"] + [f"error <= {f(l, 1)}" for l in levels], rows))
     lines.append("")

@@ -45,7 +45,7 @@ class Level:
     hc_bisect_iterations: int
     hc_flyby_dts: tuple
     workers: int = 2
-    # the work-precision problems of issue 12 and the engine-against-REBOUND table
+    # the planetary and few-body work-precision problems and the engine-against-REBOUND table
     wp_kepler_orbits: int = 100    # Kepler e = 0.9 over this many orbits
     wp_star_particles: int = 200   # test particles about a fixed star ...
     wp_star_orbits: float = 20.0   # ... for this many orbits of a = 1
@@ -79,9 +79,9 @@ QUICK = Level(
     drift_orbits=1e3, drift_steps_per_orbit=500, drift_euler_steps_per_orbit=10000,
     drift_euler_orbits=1e2, drift_tolerance=1e-10, drift_solar_days=1e6, drift_solar_dt=10.0,
     drift_samples=50,
-    wp_min_steps=100, wp_max_steps=200_000, wp_points=2,
-    wp_tolerances=(1e-4, 1e-6, 1e-8, 1e-10, 1e-12),
-    wp_ias15_epsilons=(1e-2, 1e-4, 1e-6, 1e-9),
+    wp_min_steps=100, wp_max_steps=200_000, wp_points=3,  # a slope readable on every line
+    wp_tolerances=(1e-4, 1e-5, 1e-6, 1e-8, 1e-10, 1e-12),
+    wp_ias15_epsilons=(1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-9),
     wp_repeat_below=0.2, wp_repeats=3, wp_work_cap=2e7, solar_wp_days=1e5,
     hc_e099_steps=(1000, 10000), hc_e099_orbits=10,
     hc_pyth_dts=(1e-3, 1e-4), hc_fig8_periods=100, hc_fig8_steps=(30, 100),

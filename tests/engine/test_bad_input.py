@@ -249,7 +249,7 @@ def test_rk45_impossible_tolerance_reports_collapse():
     assert np.all(np.isfinite(sim.pos))
 
 
-# -- issue 9: step counts and time in the range the compiled code handles -------------------
+# -- step counts and time in the range the compiled code handles -------------------
 @pytest.mark.parametrize("n", [2 ** 63, 2 ** 64, 2 ** 62 + 1, True, 1.0, np.float64(2.0), "3",
                                None])
 def test_step_count_outside_what_compiled_code_takes_is_refused(sim, n):
@@ -318,7 +318,7 @@ def test_rk45_time_overflow_raises_and_keeps_the_last_finite_state():
     assert math.isfinite(sim.dt) and sim.dt != 0.0
 
 
-# -- issue 9: numbers given as text or booleans, float indices, capacity -------------------
+# -- numbers given as text or booleans, float indices, capacity -------------------
 @pytest.mark.parametrize("make, field, shown", [
     (lambda: Simulation(dt="1"), "dt", "'1'"),
     (lambda: Simulation(dt=True), "dt", "True"),
@@ -368,7 +368,7 @@ def test_huge_spring_index_is_a_clear_error():
         forces.Springs(pairs=[(0, 2 ** 70)])
 
 
-# -- issue 9: index arrays of force terms are read-only and re-checked when packed ----------
+# -- index arrays of force terms are read-only and re-checked when packed ----------
 def _index_terms():
     s3 = Simulation(dim=3)
     s3.add_many(mass=1.0, pos=np.eye(3))
@@ -419,7 +419,7 @@ def test_index_arrays_are_rechecked_when_the_model_is_packed(attr, bad):
     assert s3.t == before[2]
 
 
-# -- issue 9: non-finite values written into the state arrays are bad input ------------------
+# -- non-finite values written into the state arrays are bad input ------------------
 @pytest.mark.parametrize("field, write", [
     ("mass", lambda s: s.mass.__setitem__(0, math.nan)),
     ("mass", lambda s: s.mass.__setitem__(1, math.inf)),

@@ -406,7 +406,7 @@ def test_assignments_are_checked_before_anything_changes():
 
 def test_a_removed_force_stops_acting_even_when_its_address_is_reused():
     """The packed model was keyed on id() of the terms: CPython reuses a freed term's address,
-    so a new term could be mistaken for the removed one (issue #10's first item)."""
+    so a new term could be mistaken for the removed one (a term removed and a new one added must not share an identity)."""
     import numpy as _np
 
     from engine import Simulation as _Simulation, forces as _forces

@@ -85,3 +85,53 @@ def test_time_is_a_quantity_in_the_simulations_units():
     plain = Simulation(dt=0.5)
     plain.step(2)
     assert plain.time == 1.0 and isinstance(plain.time, float)
+
+
+def _earth_about_the_sun():
+    sim = Simulation(dim=3, units=("AU", "yr", "Msun"), integrator="leapfrog", dt=1e-3)
+    sim.add(mass=1.0 * u.Msun)
+    sim.add(mass=const.M_earth, pos=[1.0, 0.0, 0.0] * u.AU, vel=[0.0, 29.78, 0.0] * u.km / u.s)
+    sim.add_force(forces.NBodyGravity())
+    return sim
+
+
+def test_time_arithmetic_with_quantities_reads_as_written():
+    sim = _earth_about_the_sun()
+    sim.integrate(sim.time + 0.5 * u.yr)
+    assert sim.time.unit == u.yr and sim.t == pytest.approx(0.5, abs=1e-12)
+    later = sim.time + 30 * u.d
+    assert later.to_value(u.yr) == pytest.approx(0.5 + 30 / 365.25, rel=1e-12)
+    sim.time = 2 * u.d
+    assert sim.t == pytest.approx(2 / 365.25, rel=1e-12)
+    with pytest.raises(ValueError, match="time"):
+        sim.time = 3 * u.kg
+
+
+def test_every_read_out_is_a_quantity_with_the_code_value():
+    sim = _earth_about_the_sun()
+    sim.step(10)
+    q = sim.quantities
+    assert q.energy.unit.is_equivalent(u.J)
+    assert q.energy.to_value(u.Msun * u.AU ** 2 / u.yr ** 2) == sim.energy()
+    assert q.kinetic_energy.value + q.potential_energy.value == pytest.approx(sim.energy())
+    np.testing.assert_array_equal(q.pos.to_value(u.AU), sim.pos)
+    np.testing.assert_array_equal(q.vel.to_value(u.AU / u.yr), sim.vel)
+    np.testing.assert_array_equal(q.mass.to_value(u.Msun), sim.mass)
+    np.testing.assert_array_equal(q.momentum.value, sim.momentum())
+    np.testing.assert_array_equal(q.angular_momentum.value, sim.angular_momentum())
+    assert q.dt.to_value(u.d) == pytest.approx(1e-3 * 365.25, rel=1e-12)
+    assert q.G.to_value(u.m ** 3 / u.kg / u.s ** 2) == pytest.approx(const.G.value, rel=1e-12)
+    com_pos, com_vel = q.center_of_mass
+    assert com_pos.unit == u.AU and com_vel.unit == u.AU / u.yr
+    # a copy: writing into the Quantity leaves the simulation alone
+    before = sim.pos.copy()
+    q.pos[0, 0] = 99 * u.AU
+    np.testing.assert_array_equal(sim.pos, before)
+    with pytest.raises(AttributeError, match="energy"):
+        q.enrgy
+
+
+def test_a_simulation_without_units_has_no_quantities():
+    sim = Simulation(dim=2)
+    with pytest.raises(ValueError, match="no units"):
+        sim.quantities

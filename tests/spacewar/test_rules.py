@@ -456,3 +456,16 @@ def test_every_mode_plays_the_bits_it_played_before_the_frame_was_made_faster(mo
         game.step(rng.integers(0, 48 if mode == "electric" else 24, size=(16, 2)))
     digest = hashlib.sha256("".join(game.state_hash(m) for m in range(16)).encode())
     assert digest.hexdigest()[:16] == _RECORDED[(mode, changes)]
+
+
+def test_the_read_outs_give_the_star_in_play():
+    for star, factor in (("heavy", 1.0), ("light", 0.25), ("none", 0.0)):
+        rules = Rules(star=star)
+        assert rules.in_play()["star_mu"] == factor * rules.star_mu == rules.effective_star_mu
+        assert Rules.from_dict(rules.to_dict()) == rules  # the stored fields round-trip
+        obs = Game(rules, seeds=[1]).observe(0, 0)
+        assert obs.star_mu == rules.in_play()["star_mu"]  # what a bot is told
+    assert "in play: 0.0" in repr(Rules(star="none"))
+    assert "in play" not in repr(Rules())
+    assert not Rules(mode="newtonian", star="none").in_play()["torpedoes_feel_star"]
+    assert Rules(mode="newtonian").in_play()["torpedoes_feel_star"]

@@ -1,4 +1,4 @@
-"""Work-precision sweeps: the integrators of issue 12 on both sides, the skips, and the
+"""Work-precision sweeps: the planetary integrators on both sides, the skips, and the
 "engine best / REBOUND best" table."""
 import math
 
