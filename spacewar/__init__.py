@@ -1,17 +1,29 @@
 """spacewar: Spacewar! (1962) on the engine, for bots: matches, tournaments, replays.
 
-``Game`` (the compiled game) is imported on first use, so a bot's process, which needs only
-the protocol, starts without loading compiled code.
+``Game`` (the compiled game), ``play_match`` (one match between two bots, see
+``spacewar.match``) and ``check_bot`` (a bot author's conformance check, see
+``spacewar.checker``) are imported on first use, so a bot's process, which needs only the
+protocol, starts without loading compiled code.
 """
 from .protocol import Action, Observation, Ship, Torpedo, NOOP
 from .rules import Rules
 
-__all__ = ["Action", "Observation", "Ship", "Torpedo", "NOOP", "Rules", "Game"]
+__all__ = ["Action", "Observation", "Ship", "Torpedo", "NOOP", "Rules", "Game", "play_match",
+           "check_bot", "CheckReport"]
+
+#: name -> (module, attribute) of the names loaded on first use
+_LAZY = {
+    "Game": (".game", "Game"),
+    "play_match": (".match", "play_match"),
+    "check_bot": (".checker", "check_bot"),
+    "CheckReport": (".checker", "CheckReport"),
+}
 
 
 def __getattr__(name):
-    if name == "Game":
-        from .game import Game
+    if name in _LAZY:
+        import importlib
 
-        return Game
+        module, attribute = _LAZY[name]
+        return getattr(importlib.import_module(module, __name__), attribute)
     raise AttributeError(f"module 'spacewar' has no attribute {name!r}")

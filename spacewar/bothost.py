@@ -66,11 +66,11 @@ def _capture_output(cap):
 
 
 def _load(config):
-    from .bots import make_bot
+    from .bots import import_top_level, make_bot
     from .rules import Rules
 
-    if config.get("path"):
-        sys.path.insert(0, config["path"])
+    if config.get("path"):  # a module:Class bot: its module from where the match found it
+        import_top_level(config["spec"], config["path"])
     from .batch_bots import is_batch_bot, one_match_bot
 
     rules = Rules.from_dict(config["rules"])

@@ -1,4 +1,5 @@
-"""The ``spacewar`` command: bots, match, tournament, league, replay, play, train."""
+"""The ``spacewar`` command: bots, match, tournament, league, replay, play, watch, train,
+new-bot, check."""
 import argparse
 import json
 import math
@@ -99,6 +100,93 @@ def _seed(text):
     return _int(text, 0, 2**63 - 1)
 
 
+class _KeysHelpFormatter(argparse.RawDescriptionHelpFormatter,
+                         argparse.ArgumentDefaultsHelpFormatter):
+    """Defaults shown after each option, and the epilog's table of keys kept as written."""
+
+
+def _speed(text):
+    """A viewer speed: one of ``keys.SPEEDS``, written as a number or a fraction (1/8)."""
+    from .keys import SPEEDS, speed_label
+
+    try:
+        if "/" in text:
+            top, bottom = text.split("/", 1)
+            value = float(top) / float(bottom)
+        else:
+            value = float(text)
+    except (ValueError, ZeroDivisionError):
+        value = None
+    if value not in SPEEDS:
+        raise argparse.ArgumentTypeError(
+            f"must be one of {', '.join(speed_label(s)[:-1] for s in SPEEDS)}, got {text!r}")
+    return value
+
+
+def _add_window_options(p, seed_help):
+    p.add_argument("--seed", type=_seed, default=0, help=seed_help)
+    p.add_argument("--rounds", type=_positive_int, default=5, help="rounds to play")
+    p.add_argument("--fps", type=lambda text: _int(text, 1, 1000), default=60,
+                   help="game frames a second at normal speed")
+    p.add_argument("--window-size", type=lambda text: _int(text, 128, 8192), default=720,
+                   metavar="PIXELS", help="side of the square window")
+    p.add_argument("--replay", metavar="FILE",
+                   help="record the match to a JSON replay file (checked before it starts; "
+                        "view it with: spacewar replay FILE --view)")
+    p.add_argument("--json", action="store_true",
+                   help="print the summary as JSON instead of a table")
+
+
+def _add_window_commands(sub):
+    """``play`` (people at the keyboard, or bots) and ``watch`` (two bots), in a window."""
+    from .keys import play_epilog, watch_epilog
+
+    p = sub.add_parser("play", formatter_class=_KeysHelpFormatter, epilog=play_epilog(),
+                       help="fly at the keyboard against a bot or a second person "
+                            "(needs the [viz] extra)")
+    p.add_argument("--p1", default="human",
+                   help="seat 1, the needle: 'human' or a bot (a built-in name, "
+                        "package.module:Class or path/to/file.py:Class)")
+    p.add_argument("--p2", default="chaser", help="seat 2, the wedge: 'human' or a bot")
+    _add_window_options(p, "the match's seed: the same seed, bots and keys give the same match")
+    _add_rules_options(p)
+    _add_fault_options(p)
+
+    w = sub.add_parser("watch", formatter_class=_KeysHelpFormatter, epilog=watch_epilog(),
+                       help="watch two bots play in a window, with pause, slow motion and "
+                            "fast forward (needs the [viz] extra)")
+    w.add_argument("--p1", default="chaser", help="seat 1, the needle: a bot")
+    w.add_argument("--p2", default="sniper", help="seat 2, the wedge: a bot")
+    w.add_argument("--speed", type=_speed, default=1.0,
+                   help="speed to start at: 1/8, 1/4, 1/2, 1, 2, 4 or 8 times real time")
+    _add_window_options(p=w, seed_help="the match's seed: the match is the one "
+                                       "'spacewar match' plays with the same seed and bots")
+    _add_rules_options(w)
+    _add_fault_options(w)
+
+
+def _add_replay_command(sub):
+    from .keys import replay_epilog
+
+    r = sub.add_parser("replay", formatter_class=_KeysHelpFormatter, epilog=replay_epilog(),
+                       help="check a replay, render it to a GIF or scrub it in a window")
+    r.add_argument("file", help="the replay file (JSON)")
+    what = r.add_mutually_exclusive_group(required=True)
+    what.add_argument("--check", action="store_true", help="re-simulate and confirm the identical outcome")
+    what.add_argument("--gif", metavar="OUT", help="render the match to an animated GIF")
+    what.add_argument("--view", action="store_true",
+                      help="show it in a window: pause, step, slow motion, fast forward and "
+                           "rewind, every frame re-simulated exactly (needs the [viz] extra)")
+    r.add_argument("--every", type=_positive_int, default=2, help="draw every n-th frame (GIF)")
+    r.add_argument("--size", type=_positive_int, default=480, help="GIF side in pixels")
+    r.add_argument("--fps", type=lambda text: _int(text, 1, 1000), default=60,
+                   help="game frames a second at normal speed (--view)")
+    r.add_argument("--speed", type=_speed, default=1.0,
+                   help="speed to start at: 1/8, 1/4, 1/2, 1, 2, 4 or 8 (--view)")
+    r.add_argument("--window-size", type=lambda text: _int(text, 128, 8192), default=720,
+                   metavar="PIXELS", help="side of the square window (--view)")
+
+
 def build_parser():
     parser = argparse.ArgumentParser(
         prog="spacewar", description="Spacewar! (1962) on an N-body engine, for bots.")
@@ -110,8 +198,10 @@ def build_parser():
     m = sub.add_parser("match", **fmt, help="play one match between two bots")
     m.add_argument("--p1", required=True, help="bot: a built-in name, package.module:Class or path/to/file.py:Class")
     m.add_argument("--p2", required=True, help="the other bot")
-    m.add_argument("--seed", type=_seed, default=0)
-    m.add_argument("--rounds", type=_positive_int, default=5)
+    m.add_argument("--seed", type=_seed, default=0,
+                   help="the match's seed: the same seed and bots give the same match")
+    m.add_argument("--rounds", type=_positive_int, default=5,
+                   help="rounds to play (a round ends when a ship dies or at the time limit)")
     m.add_argument("--json", action="store_true", help="print the result as JSON")
     m.add_argument("--replay", metavar="FILE", help="record the match to a JSON replay file")
     _add_rules_options(m)
@@ -120,8 +210,9 @@ def build_parser():
     t = sub.add_parser("tournament", **fmt, help="round robin between bots, both seat orders")
     t.add_argument("--bots", required=True, help="comma-separated bots")
     t.add_argument("--games", type=_positive_int, default=10, help="seeds per pair, each played in both seat orders")
-    t.add_argument("--seed", type=_seed, default=1)
-    t.add_argument("--rounds", type=_positive_int, default=3)
+    t.add_argument("--seed", type=_seed, default=1,
+                   help="the tournament's seed: every match's seed is derived from it")
+    t.add_argument("--rounds", type=_positive_int, default=3, help="rounds of each match")
     t.add_argument("--workers", type=_positive_int, default=None, help="worker processes (default: all cores)")
     t.add_argument("--json", action="store_true", help="print the full report as JSON")
     t.add_argument("--no-progress", action="store_true", help="no progress bar")
@@ -146,7 +237,8 @@ def build_parser():
                     help="swiss: neighbours in the ratings so far; sampled: random")
     lg.add_argument("--games", type=_positive_int, default=2,
                     help="seeds per pairing, each played in both seat orders")
-    lg.add_argument("--seed", type=_seed, default=1)
+    lg.add_argument("--seed", type=_seed, default=1,
+                    help="the league's seed: pairings and every match's seed derive from it")
     lg.add_argument("--match-rounds", type=_positive_int, default=3, help="rounds of each match")
     lg.add_argument("--bootstrap", type=_non_negative_int, default=200,
                     help="bootstrap resamples for the Bradley-Terry intervals")
@@ -159,24 +251,13 @@ def build_parser():
     _add_rules_options(lg)
     _add_fault_options(lg)
 
-    r = sub.add_parser("replay", **fmt, help="check a replay or render it to a GIF")
-    r.add_argument("file")
-    what = r.add_mutually_exclusive_group(required=True)
-    what.add_argument("--check", action="store_true", help="re-simulate and confirm the identical outcome")
-    what.add_argument("--gif", metavar="OUT", help="render the match to an animated GIF")
-    r.add_argument("--every", type=_positive_int, default=2, help="draw every n-th frame (GIF)")
-    r.add_argument("--size", type=_positive_int, default=480, help="GIF side in pixels")
+    _add_replay_command(sub)
 
     b = sub.add_parser("sandbox", **fmt, help="show what confines an isolated bot on this machine, "
                                               "by running a probe bot that tries each attack")
     b.add_argument("--json", action="store_true", help="print the findings as JSON")
 
-    p = sub.add_parser("play", **fmt, help="you at the keyboard against a bot (needs the [viz] extra)")
-    p.add_argument("--p2", default="chaser", help="the bot to play against")
-    p.add_argument("--seed", type=_seed, default=0)
-    p.add_argument("--rounds", type=_positive_int, default=5)
-    p.add_argument("--fps", type=_positive_int, default=60)
-    _add_rules_options(p)
+    _add_window_commands(sub)
 
     tr = sub.add_parser("train", **fmt, help="train a policy with PPO and save it as .npz "
                                              "(needs the [rl] extra: JAX and optax)")
@@ -192,7 +273,39 @@ def build_parser():
                     help="stop after this many frames over all matches (reproducible); "
                          "None: when the minutes are up")
     tr.add_argument("--no-progress", action="store_true", help="no progress bar")
+    _add_author_commands(sub, fmt)
     return parser
+
+
+def _add_author_commands(sub, fmt):
+    """The ``new-bot`` and ``check`` subcommands: a bot author's first steps."""
+    from .bots import available
+
+    n = sub.add_parser("new-bot", **fmt, help="write a commented starter bot that runs as it is")
+    n.add_argument("name", metavar="NAME",
+                   help="the bot's name, a Python identifier: NAME.py holds class Name "
+                        "(hunter -> Hunter, my_bot -> MyBot)")
+    n.add_argument("--out", metavar="PATH", default=None,
+                   help="the .py file to write, or an existing directory to write NAME.py in; "
+                        "never overwritten; None: NAME.py in the current directory")
+
+    c = sub.add_parser("check", **fmt,
+                       help="check a bot before a tournament: it loads, has no faults, answers "
+                            "within the budget, plays a seed the same way twice; exit 1 if not")
+    c.add_argument("bot", metavar="BOT",
+                   help="the bot: path/to/file.py:Class, package.module:Class or a built-in name")
+    c.add_argument("--games", type=_positive_int, default=1,
+                   help="seeds played against each opponent, each from both seats")
+    c.add_argument("--seed", type=_seed, default=0,
+                   help="the first seed; game g plays seed + g")
+    c.add_argument("--rounds", type=_positive_int, default=1, help="rounds of each match")
+    c.add_argument("--opponents", default=",".join(available()),
+                   help="comma-separated opponents: built-in names or any bot specification")
+    c.add_argument("--json", action="store_true", help="print the report as JSON")
+    c.add_argument("--no-progress", action="store_true",
+                   help="do not list the matches on stderr as they are played")
+    _add_rules_options(c)
+    _add_fault_options(c)
 
 
 def _describe_match(result, timing):
@@ -356,11 +469,23 @@ def _cmd_replay(args):
             return 0
         print(f"MISMATCH: {args.file}: {json.dumps(details['mismatches'], sort_keys=True)}")
         return 1
+    if args.view:
+        return _in_window("replay", _view_replay, data, args)
     from .render import render_gif
 
     check_output_path(args.gif, "gif")
     render_gif(data, args.gif, every=args.every, size=args.size)
     print(f"wrote {args.gif}")
+    return 0
+
+
+def _view_replay(data, args):
+    from .viewer import view_replay
+
+    summary = view_replay(data, fps=args.fps, scale=args.window_size, speed=args.speed)
+    end = {True: "the final state is the recorded one", False: "the final state DIFFERS "
+           "from the recording", None: "the end was not reached"}[summary["recorded_end"]]
+    print(f"left the replay at frame {summary['frame']} of {summary['total']}; {end}")
     return 0
 
 
@@ -375,12 +500,40 @@ def _cmd_sandbox(args):
     return 0 if findings["ok"] else 1
 
 
-def _cmd_play(args):
-    from .play import play
+def _in_window(command, run, *args):
+    """Run a window command; no display is one line on stderr and exit status 2."""
+    from .viewer import NoDisplayError
 
-    summary = play(p2=args.p2, rules=_rules_from(args), seed=args.seed, rounds=args.rounds,
-                   fps=args.fps)
-    print(summary)
+    try:
+        return run(*args)
+    except NoDisplayError as exc:
+        print(f"spacewar {command}: {exc}", file=sys.stderr)
+        return 2
+
+
+def _cmd_play(args):
+    return _in_window("play", _play_in_window, args, False)
+
+
+def _cmd_watch(args):
+    return _in_window("watch", _play_in_window, args, True)
+
+
+def _play_in_window(args, watching):
+    from .play import format_summary, play, watch
+
+    _check_policy_files([spec for spec in (args.p1, args.p2) if spec.strip().lower() != "human"])
+    options = dict(rules=_rules_from(args), seed=args.seed, rounds=args.rounds, fps=args.fps,
+                   scale=args.window_size, limits=_limits_from(args),
+                   max_faults=args.max_faults, isolation=args.isolation, record_to=args.replay)
+    if watching:
+        summary = watch(args.p1, args.p2, speed=args.speed, **options)
+    else:
+        summary = play(args.p2, p1=args.p1, **options)
+    if args.json:
+        print(json.dumps(summary, sort_keys=True, indent=2))
+    else:
+        print(format_summary(summary))
     return 0
 
 
@@ -396,8 +549,52 @@ def _cmd_train(args):
     return 0
 
 
+def _cmd_new_bot(args):
+    import shlex
+
+    from .starter import write_starter
+
+    try:
+        path, spec = write_starter(args.name, args.out)
+    except FileExistsError as exc:
+        print(f"spacewar new-bot: error: {exc}", file=sys.stderr)
+        return 2
+    bot = shlex.quote(spec)
+    print(f"wrote {path}: a starter bot (class {spec.rsplit(':', 1)[1]}) that turns towards the "
+          "enemy, fires when lined up and keeps clear of the star")
+    print("next, try:")
+    print(f"  spacewar match --p1 {bot} --p2 idle")
+    print(f"  spacewar match --p1 {bot} --p2 chaser --replay game.json")
+    print("  spacewar replay game.json --gif game.gif")
+    print(f"  spacewar check {bot}")
+    print(f"then make it yours: the conventions are at the top of {path}, and more is in the "
+          "section 'Writing a bot' of the project's docs/game.md")
+    return 0
+
+
+def _cmd_check(args):
+    from .checker import check_bot
+
+    def show(match):
+        again = " (the same match again)" if match.get("repeat") else ""
+        print(f"  vs {match['opponent']}, seat {match['seat'] + 1}, seed {match['seed']}: "
+              f"{match['outcome']} {match['score'][0]}-{match['score'][1]}{again}",
+              file=sys.stderr)
+
+    report = check_bot(args.bot, opponents=args.opponents, games=args.games, seed=args.seed,
+                       rounds=args.rounds, rules=_rules_from(args), limits=_limits_from(args),
+                       max_faults=args.max_faults, isolation=args.isolation,
+                       on_match=None if args.json or args.no_progress else show)
+    if args.json:
+        print(json.dumps(report.to_dict(), sort_keys=True, indent=2))
+    else:
+        print(report.format())
+    return 0 if report.passed else 1
+
+
 COMMANDS = {"train": _cmd_train, "bots": _cmd_bots, "match": _cmd_match, "tournament": _cmd_tournament, "league": _cmd_league,
-            "replay": _cmd_replay, "play": _cmd_play, "sandbox": _cmd_sandbox}
+            "replay": _cmd_replay, "play": _cmd_play, "watch": _cmd_watch, "sandbox": _cmd_sandbox,
+            "new-bot": _cmd_new_bot, "check": _cmd_check}
 
 
 def main(argv=None):

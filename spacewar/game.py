@@ -5,6 +5,9 @@
         game.step(actions)            # (M, 2) action codes or Action objects
     game.scores                       # (M, 2)
 
+    saved = game.checkpoint(0)        # match 0's whole state, copied
+    game.restore(saved, 0)            # back to it: stepping on gives bit-identical frames
+
 The matches are one ``engine.Batch`` (a system per match, on the periodic space of side 1). The
 force model of a mode is declared on it with the engine's own force terms (only the terms the
 mode needs) and packed by the engine; the compiled frame then calls the engine's per-system
@@ -82,6 +85,34 @@ def seed_state(seed):
     """A 64-bit stream state from any non-negative int seed (via numpy's SeedSequence)."""
     seed = count_at_least("seed", seed, 0)
     return np.random.SeedSequence(seed).generate_state(1, np.uint64)[0]
+
+
+class Checkpoint:
+    """One match's complete state at one frame, as read-only copies (``Game.checkpoint``).
+
+    It holds the match's row of every array the compiled frame reads and writes: the engine's
+    bodies (positions, velocities, masses, charges, radii and the active, test and pinned
+    flags), the packed force parameters (the engines' thrust is written there every frame),
+    the ships' gauges and counters, the torpedoes' lifetimes, the match's counters and scores
+    and its random stream. The arrays every match shares and no frame changes (the rules
+    vector, the force layout, the integrator's coefficients) are not copied; ``layout``
+    records them, so a checkpoint is only restored into a game whose frames they would step
+    identically. ``frame`` is the match's frame number; ``nbytes`` what the copies take.
+    """
+
+    __slots__ = ("frame", "arrays", "layout")
+
+    def __init__(self, frame, arrays, layout):
+        self.frame = frame
+        self.arrays = arrays
+        self.layout = layout
+
+    @property
+    def nbytes(self):
+        return sum(a.nbytes for a in self.arrays)
+
+    def __repr__(self):
+        return f"Checkpoint(frame={self.frame}, {self.nbytes} bytes)"
 
 
 class Game:
@@ -289,6 +320,71 @@ class Game:
                 "torpedoes": [{"pos": self.pos[m, :, b].tolist(), "owner": (b - 2) // t} for b in live],
                 "star": self.rules.effective_star_mu > 0, "over": bool(self.match_state[m, core.OVER])}
 
+    # -- checkpoints --------------------------------------------------------------------
+    def _match_rows(self, m):
+        """Match m's row of every per-match array the compiled frame reads or writes, as
+        writeable views into the game's storage, in a fixed order (see ``Checkpoint``)."""
+        state = self.state
+        rows = slice(m, m + 1)
+        return [state.pos[rows], state.vel[rows], state.mass[rows], state.charge[rows],
+                state.radius[rows], state.active[rows], state.test[rows], state.pinned[rows],
+                self.model.params[rows], self.ship_gauges[rows], self.ship_counters[rows],
+                self.torp_life[rows], self.match_state[rows], self.rng[rows]]
+
+    def _layout(self):
+        """What a checkpoint's arrays mean: the shared arrays that every frame reads but none
+        changes (rules, rounds and thrust columns in the rules vector; the packed force
+        layout; the integrator's coefficients) and the per-match arrays' shapes and types."""
+        cached = getattr(self, "_layout_cache", None)
+        if cached is not None and cached[0] == self._revision:
+            return cached[1]  # shared by every checkpoint of this packing, not one per copy
+        model = self.model
+        shared = (self.rules_vector, model.kinds, model.param_offsets, model.indices,
+                  model.index_offsets, self.drifts, self.kicks)
+        shapes = tuple((a.shape[1:], a.dtype.str) for a in self._match_rows(0))
+        layout = (tuple(np.ascontiguousarray(a).tobytes() for a in shared), shapes,
+                  int(self.state.n), float(self.state.box))
+        self._layout_cache = (self._revision, layout)
+        return layout
+
+    def _match_index(self, m):
+        if isinstance(m, bool) or not isinstance(m, (int, np.integer)) or not 0 <= m < self.n_matches:
+            raise ValueError(f"m must be a match index in [0, {self.n_matches}), got {m!r}")
+        return int(m)
+
+    def checkpoint(self, m=0):
+        """A ``Checkpoint`` of match ``m``: copies of its whole state, to ``restore`` later.
+
+        Restoring it and stepping with the same action codes gives bit-identical states
+        (``state_hash``) to the run that made it: the frame is a pure function of these arrays
+        and the codes. Each checkpoint is about 5 KB under the 1962 rules (32 torpedoes a
+        ship); ``spacewar.timeline`` keeps a bounded number of them to scrub a replay.
+        """
+        m = self._match_index(m)
+        self._sync_with_batch()
+        arrays = []
+        for row in self._match_rows(m):
+            copy = row.copy()
+            copy.flags.writeable = False  # a checkpoint restores the same state every time
+            arrays.append(copy)
+        return Checkpoint(int(self.match_state[m, core.FRAME]), tuple(arrays), self._layout())
+
+    def restore(self, checkpoint, m=0):
+        """Put match ``m`` back in the state of ``checkpoint`` (from ``checkpoint`` of this
+        game or of another with the same rules and rounds; any match index). Checked before
+        anything is changed: a checkpoint of a game with other rules, rounds or force layout
+        raises ValueError and leaves the game as it was. The other matches are untouched."""
+        if not isinstance(checkpoint, Checkpoint):
+            raise TypeError(f"checkpoint must be a spacewar.game.Checkpoint (from "
+                            f"Game.checkpoint), got {type(checkpoint).__name__}")
+        m = self._match_index(m)
+        self._sync_with_batch()
+        if checkpoint.layout != self._layout():
+            raise ValueError(f"checkpoint of frame {checkpoint.frame} was taken in a game with "
+                             "other rules, rounds or force layout; it cannot be restored here")
+        for row, saved in zip(self._match_rows(m), checkpoint.arrays):
+            row[...] = saved
+
     def state_hash(self, m=0):
         """SHA-256 of every array of match ``m``: equal hashes mean bit-identical states."""
         h = hashlib.sha256()
@@ -314,4 +410,4 @@ class Game:
         return np.concatenate(parts)
 
 
-__all__ = ["Game", "force_terms", "seed_state"]
+__all__ = ["Game", "Checkpoint", "force_terms", "seed_state"]

@@ -1,5 +1,6 @@
 """A match between two bots: fault-isolated seats, optional replay, a deterministic result.
 
+    from spacewar import play_match          # or spacewar.match.play_match
     result, replay, timing = play_match("chaser", "sniper", seed=7, rounds=5)
     result["winner"], result["score"]
 
@@ -54,18 +55,40 @@ class FaultLog:
 
 def play_match(p1, p2, seed=0, rounds=5, rules=None, budget=DEFAULT_BUDGET,
                max_faults=DEFAULT_MAX_FAULTS, isolation="auto", record=False, on_frame=None,
-               limits=None):
+               limits=None, act_seconds=False):
     """Play one match; return ``(result, replay, timing)``.
 
-    ``result`` is the plain-data result (see the module docstring), ``replay`` the replay
-    dict when ``record`` is true (else None), ``timing`` the wall-clock figures (kept out of
-    the result so that results are byte-identical). ``p1`` and ``p2`` are bot specifications
-    (see ``spacewar.bots``) or bot objects; built-in bots and bot objects play in this
-    process, every other bot in its own confined process (``spacewar.seats``). ``limits`` (a ``spacewar.seats.Limits``) sets every
-    budget; ``budget`` alone sets the per-action one. ``on_frame(game)`` is called after every
-    frame. A bot that cannot start, dies, breaks the protocol, hangs or reaches ``max_faults``
-    forfeits; the other bot wins (if both forfeit, nobody does).
+    ``p1`` and ``p2`` (seats 0 and 1) are each a bot specification (a built-in name,
+    ``package.module:Class``, ``path/to/file.py:Class`` or a policy ``.npz``: see
+    ``spacewar.bots``) or a bot object (an instance of any class with ``act(self, obs) ->
+    Action``, or a batch bot with ``act_batch``). Built-in bots and bot objects play in this
+    process (an object is the caller's own code), every other bot in its own confined
+    process (``spacewar.seats``). A class instead of an instance is refused (TypeError).
+
+    ``seed`` (int >= 0) fixes the match: the same seed and bots give a byte-identical result.
+    ``rounds``: rounds to play (ties add up to ``rules.max_extra_rounds``). ``rules``: a
+    ``spacewar.Rules`` (default the 1962 game). ``limits`` (a ``spacewar.seats.Limits``) sets
+    every budget; ``budget`` alone sets the per-action one (seconds). A bot that cannot start,
+    dies, breaks the protocol, hangs or reaches ``max_faults`` faults forfeits; the other bot
+    wins (if both forfeit, nobody does). ``isolation``: ``"auto"``, ``"process"`` (built-in
+    bots confined too) or ``"inline"``. ``on_frame(game)`` is called after every frame.
+
+    Returns:
+
+    - ``result``: plain data, JSON-ready, holding no wall-clock figure: ``bots`` (names),
+      ``winner`` (a name or None), ``winner_seat`` (0, 1 or None), ``score`` [seat 0, seat 1],
+      ``rounds`` (played), ``steps`` (frames), ``forfeit``, ``forfeits``, ``error``,
+      ``faults`` (per seat), ``seed``, ``rounds_asked``, ``rules`` (a dict), ``output``;
+    - ``replay``: the replay dict (``spacewar.replay``) when ``record`` is true, else None;
+    - ``timing``: wall-clock figures, kept out of the result so that results are
+      byte-identical: ``wall_seconds``, ``frames_per_second``, ``act`` (per seat, a summary of
+      the time of each action as charged against the budget: ``count``, ``mean``, ``p50``,
+      ``p95``, ``p99``, ``max`` in seconds, see ``act_time_summary``) and, when
+      ``act_seconds`` is true, ``act_seconds`` (per seat, a float64 array of every action's
+      time, in the order asked).
     """
+    for field, bot in (("p1", p1), ("p2", p2)):
+        _check_bot_argument(field, bot)
     rules = Rules() if rules is None else rules
     count_at_least("seed", seed, 0)
     limits = checked_limits(max_faults, budget, limits)
@@ -120,12 +143,40 @@ def play_match(p1, p2, seed=0, rounds=5, rules=None, budget=DEFAULT_BUDGET,
     wall = time.perf_counter() - start
     result = _result(game, (bot_name(p1), bot_name(p2)), seed, rounds, rules, faults, forfeits, outputs)
     result_timing = {"wall_seconds": wall, "frames_per_second": result["steps"] / max(wall, 1e-9)}
+    times = [np.frombuffer(seat.act_seconds, dtype=np.float64).copy() for seat in seats]
+    result_timing["act"] = [act_time_summary(t) for t in times]
+    if act_seconds:
+        result_timing["act_seconds"] = times
     if record:
         from .replay import make_replay
 
         return result, make_replay(result, bytes(history), game.state_hash(0),
                                    faults=bytes(fault_codes), max_faults=max_faults), result_timing
     return result, None, result_timing
+
+
+def _check_bot_argument(field, bot):
+    """A bot argument of ``play_match`` that can never play is a TypeError naming it."""
+    if isinstance(bot, str):
+        return
+    if isinstance(bot, type):
+        raise TypeError(f"{field} must be a bot specification or a bot object, got the class "
+                        f"{bot.__qualname__}: pass an instance, {bot.__qualname__}()")
+    if not callable(getattr(bot, "act", None)) and not callable(getattr(bot, "act_batch", None)):
+        raise TypeError(f"{field} must be a bot specification (str) or an object with "
+                        f"act(obs), got {type(bot).__name__} {bot!r:.80}")
+
+
+def act_time_summary(seconds):
+    """A summary of per-action times (seconds): ``count``, ``mean``, ``p50``, ``p95``,
+    ``p99`` and ``max``, the percentiles by linear interpolation between the order statistics
+    (numpy's default). Every figure is None when there is no time at all."""
+    seconds = np.asarray(seconds, dtype=np.float64)
+    if seconds.size == 0:
+        return {"count": 0, "mean": None, "p50": None, "p95": None, "p99": None, "max": None}
+    p50, p95, p99 = np.percentile(seconds, (50.0, 95.0, 99.0)).tolist()
+    return {"count": int(seconds.size), "mean": float(seconds.mean()), "p50": p50, "p95": p95,
+            "p99": p99, "max": float(seconds.max())}
 
 
 def checked_limits(max_faults, budget, limits):

@@ -1,378 +1,573 @@
-"""Play Spacewar! at the keyboard against a bot, in a pygame window.
+"""Spacewar! in a pygame window: people at the keyboard, bots, or two bots to watch.
 
-    from spacewar.play import play
-    play("chaser", rounds=5)
+    from spacewar.play import play, watch
+    play("chaser", rounds=5)               # you fly the needle (seat 1) against the chaser
+    play(p1="human", p2="human")           # two people at one keyboard
+    watch("chaser", "sniper")              # two bots; pause, slow motion, fast forward
 
-You fly the needle (seat 0, blue); the bot flies the wedge (seat 1, orange). Keys:
+Who flies with which keys is in ``spacewar.keys``: one person (in either seat) gets both hands'
+keys, A/D or Left/Right to turn, W or Up to thrust, Space or S to fire, H (or both turn keys)
+for hyperspace, F to flip polarity; two people get WASD (player 1) and the arrows with the
+right-hand keys or the numeric keypad (player 2). P pauses, Esc quits.
 
-    A / D  or  Left / Right     turn (anticlockwise / clockwise)
-    W  or  Up                   thrust
-    Space  or  S                fire
-    H, or both turn keys        hyperspace (as on the 1962 control boxes)
-    F                           flip polarity (electric mode)
-    P                           pause / resume
-    Esc                         quit
+The game runs ``fps`` frames a second whatever the drawing rate (``spacewar.viewer.Pace``: the
+engine's fixed-step clock turns wall time into whole frames, and the drawing blends the last
+two frames by the clock's remainder); ``watch`` can run it from 1/8x to 8x, pause it and step
+it frame by frame, since simulation time is not wall time. A bot plays exactly as in
+``spacewar.match``: in a fault-isolated seat (``spacewar.seats.open_seat``; a bot that is not
+built in runs in its own confined process), a fault costs it its turn, ``max_faults`` faults or
+a dead bot forfeit the match. So ``watch`` with the same bots and seed plays the same match as
+``spacewar match`` (while the bots keep within their budgets), and either can be recorded and
+then scrubbed with ``spacewar replay FILE --view``.
 
-The game runs at ``fps`` frames a second whatever the drawing rate: an
-``engine.clock.FixedStepClock`` turns wall time into whole game frames, and the drawing
-blends the last two frames by the clock's ``alpha``. The bot sits in a fault-isolated seat
-(``spacewar.seats.open_seat``), so a bot that raises or dawdles only loses its turn.
-pygame is part of the optional ``[viz]`` extra and is imported only by ``play``.
+pygame is part of the optional ``[viz]`` extra and is imported only when a window opens.
 """
 import math
-import os
-import time
-from bisect import bisect_right
 
 import numpy as np
 
 from engine import space
+from engine.atomic import check_output_path
 
 from . import core
+from . import keys as K
 from .game import Game
-from .match import bot_seed
-from .protocol import Action
-from .render import DIM_TEXT, SHIP_COLOURS, VIZ_HINT, Effects, scene
+from .match import DEFAULT_MAX_FAULTS, FaultLog, _cpu_seconds, bot_seed, checked_limits
+from .match import _result as match_result
+from .protocol import Action, raw_length
+from .render import DIM_TEXT, TEXT, Effects, frame_snapshot, scene
 from .rules import Rules
-from .seats import Limits, open_seat
+from .seats import FAULT_KINDS, bot_name, open_seat
+from .viewer import (WATCH_SCREEN_HELP, Pace, Window, blend, check_display, check_speed,
+                     check_window_arguments, help_lines, run_window)
+from .viewer import paint as _paint  # noqa: F401  (the name the Gymnasium env's window uses)
+from .viewer import require_pygame
 
 BOT_BUDGET = 0.05  # seconds per bot action
-RENDER_CAP = 120  # most drawn frames a second
+HUMAN = "human"
 
-TURN_LEFT = frozenset({"a", "left"})
-TURN_RIGHT = frozenset({"d", "right"})
-THRUST = frozenset({"w", "up"})
-FIRE = frozenset({"space", "s"})
-HYPERSPACE = frozenset({"h"})
-FLIP = frozenset({"f"})
+# the keys of one person at the keyboard, as they have always been named here
+TURN_LEFT = K.SOLO.left
+TURN_RIGHT = K.SOLO.right
+THRUST = K.SOLO.thrust
+FIRE = K.SOLO.fire
+HYPERSPACE = K.SOLO.hyperspace
+FLIP = K.SOLO.flip
 PAUSE = "p"
 QUIT = "escape"
-#: every key name the game reads (pygame's names for them)
-KEY_NAMES = TURN_LEFT | TURN_RIGHT | THRUST | FIRE | HYPERSPACE | FLIP | {PAUSE, QUIT}
+#: every key name ``play`` reads (pygame's names for them)
+KEY_NAMES = K.PLAY_KEY_NAMES
 
-#: (keys, what they do): shown on screen and in the help
-KEYS_HELP = (
-    ("A/D or Left/Right", "turn"),
-    ("W or Up", "thrust"),
-    ("Space or S", "fire"),
-    ("H or both turn keys", "hyperspace"),
-    ("F", "flip polarity"),
-    ("P", "pause"),
-    ("Esc", "quit"),
-)
+#: (keys, what they do) of one person at the keyboard: shown on screen and in the help
+KEYS_HELP = K.SOLO.help() + K.PLAY_CONTROLS_HELP
 
 
-def require_pygame():
-    """The pygame module, or an ImportError saying how to get it."""
-    os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
-    try:
-        import pygame
-    except ImportError as exc:
-        raise ImportError(f"playing Spacewar! needs pygame, part of the optional [viz] extra: "
-                          f"{VIZ_HINT}") from exc
-    return pygame
-
-
-def action_code(held):
-    """The action code for the set of held key names (pressing both turns is hyperspace)."""
-    left = bool(held & TURN_LEFT)
-    right = bool(held & TURN_RIGHT)
-    both = left and right
-    turn = 0 if left == right else (1 if left else -1)  # +1 is anticlockwise, screen y is up
-    return Action(turn=turn, thrust=bool(held & THRUST), fire=bool(held & FIRE),
-                  hyperspace=bool(held & HYPERSPACE) or both, flip=bool(held & FLIP)).code()
-
-
-def _key_set(keys, where):
-    if isinstance(keys, str):
-        keys = {keys}
-    try:
-        names = frozenset(str(k).lower() for k in keys)
-    except TypeError:
-        raise ValueError(f"{where}: keys must be a set of key names, got {keys!r}") from None
-    unknown = sorted(names - KEY_NAMES)
-    if unknown:
-        raise ValueError(f"{where}: unknown key name(s) {', '.join(map(repr, unknown))}; "
-                         f"known: {', '.join(sorted(KEY_NAMES))}")
-    return names
+def action_code(held, keyset=K.SOLO):
+    """The action code for the set of held key names under ``keyset`` (default: one person's
+    keys); pressing both turn keys is hyperspace."""
+    turn, thrust, fire, hyperspace, flip = keyset.action(held)
+    return Action(turn=turn, thrust=thrust, fire=fire, hyperspace=hyperspace, flip=flip).code()
 
 
 def script_source(script):
-    """A function ``frame -> frozenset of held key names`` from a ``play`` script.
+    """``keys.script_source`` for the keys ``play`` reads: a function ``tick -> held keys``
+    from a callable or a sequence of ``(tick, keys)``; ticks count the window's fixed-rate
+    ticks from the start, paused or not."""
+    return K.script_source(script, KEY_NAMES)
 
-    ``script`` is either a callable ``frame -> keys`` or a sequence of ``(frame, keys)``:
-    from each listed frame on, exactly those keys are held (until the next entry). Frames
-    count the game's fixed-rate ticks from the start, paused or not (so a script can pause
-    and resume); a key appearing in a frame's set that was not held the frame before is a
-    press (which is what toggles pause and quits).
+
+# -- seats --------------------------------------------------------------------------------------
+class KeyboardSeat:
+    """A person's seat: the action is what their keys (``keyset``) hold at the frame.
+
+    It has the shape of ``spacewar.seats`` seats (``act``, ``dead``, ``close``), so a match
+    loop treats people and bots alike; a person never faults.
     """
-    if callable(script):
-        return lambda frame: _key_set(script(frame), f"script({frame})")
+
+    def __init__(self, name, keyset):
+        self.spec = name
+        self.keyset = keyset
+        self.held = frozenset()
+        self.dead = None
+
+    def wait_ready(self):
+        return None
+
+    def act(self, raw):
+        return action_code(self.held, self.keyset), None
+
+    def close(self):
+        return {"text": "", "bytes": 0, "truncated": False}
+
+
+def _is_human(spec):
+    return isinstance(spec, str) and spec.strip().lower() == HUMAN
+
+
+def _people_names(specs):
+    """Each seat's name in the result: a bot's specification; ``human`` for one person,
+    ``human 1`` and ``human 2`` for two."""
+    people = [s for s, spec in enumerate(specs) if _is_human(spec)]
+    names = []
+    for s, spec in enumerate(specs):
+        if not _is_human(spec):
+            names.append(bot_name(spec))
+        else:
+            names.append(HUMAN if len(people) == 1 else f"{HUMAN} {s + 1}")
+    return names
+
+
+def _keysets(specs):
+    """Each person's keys: both hands' for one person, WASD and the arrows for two."""
+    people = [s for s, spec in enumerate(specs) if _is_human(spec)]
+    if len(people) == 1:
+        return {people[0]: K.SOLO}
+    return {s: (K.PLAYER_1, K.PLAYER_2)[s] for s in people}
+
+
+def _open_seats(specs, names, seed, limits, rules, rounds, isolation):
+    """The two seats, bots started and ready; a bot that cannot start is a ValueError
+    naming it (nothing is left running)."""
+    keysets = _keysets(specs)
+    cpu = _cpu_seconds(rules, rounds, limits)  # a confined bot's CPU time, as in a match
+    seats = []
     try:
-        entries = sorted((int(f), _key_set(keys, f"script entry at frame {f}")) for f, keys in script)
-    except (TypeError, ValueError) as exc:
-        if isinstance(exc, ValueError) and "key" in str(exc):
-            raise
-        raise ValueError("script must be a callable or a sequence of (frame, set of key names), "
-                         f"got {script!r}") from None
-    frames = [f for f, _ in entries]
-    empty = frozenset()
-
-    def held(frame):
-        i = bisect_right(frames, frame) - 1
-        return entries[i][1] if i >= 0 else empty
-
-    return held
-
-
-def _pygame_keys(pygame):
-    """pygame key constant -> key name, for the keys the game reads."""
-    return {getattr(pygame, "K_" + (name if len(name) == 1 else name.upper())): name
-            for name in KEY_NAMES}
+        for s, spec in enumerate(specs):
+            if s in keysets:
+                seats.append(KeyboardSeat(names[s], keysets[s]))
+                continue
+            seat = open_seat(spec, bot_seed(seed, s), limits, rules, isolation, cpu, rounds=rounds)
+            seats.append(seat)
+            if getattr(seat, "wait_ready", None) is not None and seat.wait_ready() is not None:
+                raise ValueError(f"bot {names[s]!r} (seat {s + 1}) could not start: "
+                                 f"{seat.dead[1]}")
+    except BaseException:
+        for seat in seats:
+            seat.close()
+        raise
+    return seats
 
 
-def _paint(pygame, surface, prims, fonts):
-    surface.fill((0, 0, 0))
-    for p in prims:
-        kind = p[0]
-        if kind == "dot":
-            _, x, y, r, rgb = p
-            if r < 0.75:
-                surface.set_at((int(x), int(y)), rgb)
-            else:
-                pygame.draw.circle(surface, rgb, (x, y), r)
-        elif kind == "ring":
-            _, x, y, r, rgb, width = p
-            if r >= 1.0:
-                pygame.draw.circle(surface, rgb, (x, y), r, width)
-        elif kind == "poly":
-            _, points, rgb, width = p
-            if width <= 1:
-                pygame.draw.aalines(surface, rgb, True, points)
-            else:
-                pygame.draw.lines(surface, rgb, True, points, width)
-        elif kind == "fill":
-            _, points, rgb = p
-            pygame.draw.polygon(surface, rgb, points)
-        elif kind == "line":
-            _, x0, y0, x1, y1, rgb, width = p
-            pygame.draw.line(surface, rgb, (x0, y0), (x1, y1), width)
-        elif kind == "text":
-            _, x, y, text, rgb, align, pixels = p
-            font = fonts.get(pixels)
-            if font is None:
-                font = fonts[pixels] = pygame.font.Font(None, int(pixels * 1.35))
-            image = font.render(text, True, rgb)
-            if align == "centre":
-                x -= image.get_width() / 2.0
-            elif align == "right":
-                x -= image.get_width()
-            surface.blit(image, (x, y))
+# -- a match played at the window's pace ------------------------------------------------------
+class LiveMatch:
+    """One match played a frame at a time when the window asks, with the rules of
+    ``spacewar.match.play_match``: both seats asked each frame (seat 1 first), a fault
+    recorded and played as a no-op, a seat whose bot died or reached ``max_faults`` faults
+    forfeits. Keeps the frame-by-frame records of a replay and a few statistics per seat.
+    """
+
+    def __init__(self, game, seats, names, seed, rounds, max_faults):
+        self.game = game
+        self.seats = seats
+        self.names = names
+        self.seed = seed
+        self.rounds = rounds
+        self.max_faults = max_faults
+        self.faults = [FaultLog(), FaultLog()]
+        self.forfeits = [False, False]
+        self.history = bytearray()
+        self.fault_codes = bytearray()
+        self.fired = [0, 0]
+        self.distance = [0.0, 0.0]
+        self.jumps = [0, 0]
+        self.previous_positions = None  # (pos, active) before the last frame played
+        self.effects = Effects()  # the drawing's flashes and bursts, fed every frame played
+        self.effects.update(frame_snapshot(game))
+        self._actions = np.full((1, 2), 0, dtype=np.int64)
+        self._raws = np.empty((2, raw_length(game.rules)))
+        for s in range(2):
+            game._write_raw(0, s, self._raws[s])
+
+    @property
+    def over(self):
+        return bool(self.game.over[0]) or any(self.forfeits)
+
+    @property
+    def people(self):
+        """The seats people fly."""
+        return [s for s, seat in enumerate(self.seats) if isinstance(seat, KeyboardSeat)]
+
+    def set_keys(self, held):
+        """What the people's keys hold now (each person's seat reads its own keys of it)."""
+        for seat in self.seats:
+            if isinstance(seat, KeyboardSeat):
+                seat.held = held
+
+    def play_frame(self):
+        """Ask both seats, then step the game one frame (unless a seat forfeited)."""
+        game = self.game
+        frame = int(game.match_state[0, core.FRAME])
+        kinds = [0, 0]
+        for s, seat in enumerate(self.seats):
+            code, fault = seat.act(self._raws[s])
+            self._actions[0, s] = code
+            if fault is not None:
+                self.faults[s].add(frame, *fault)
+                kinds[s] = 1 + FAULT_KINDS.index(fault[0])
+            if seat.dead is not None or self.faults[s].total >= self.max_faults:
+                self.forfeits[s] = True
+        self.fault_codes += bytes(kinds)
+        if any(self.forfeits):
+            return
+        before = self._counters()
+        self.previous_positions = (game.pos[0].copy(), game.active[0].copy())
+        game._step_one_codes(0, self._actions, self._raws)
+        self.history += bytes((int(self._actions[0, 0]), int(self._actions[0, 1])))
+        self._count(before)
+        self.effects.update(frame_snapshot(game))
+
+    def _counters(self):
+        game = self.game
+        return (game.rounds_played(0), game.ship_counters[0, :, core.TORPS].copy(),
+                game.ship_counters[0, :, core.IN_HYPER].copy())
+
+    def _count(self, before):
+        """Torpedoes fired, hyperspace jumps and distance flown in the frame just played."""
+        game = self.game
+        round_before, torpedoes_before, hyper_before = before
+        if game.rounds_played(0) != round_before:
+            return  # a new round reset the ships
+        prev_pos, prev_active = self.previous_positions
+        for s in range(2):
+            self.fired[s] += int(max(0, torpedoes_before[s] - game.ship_counters[0, s, core.TORPS]))
+            if game.ship_counters[0, s, core.IN_HYPER] and not hyper_before[s]:
+                self.jumps[s] += 1
+            if prev_active[s] and game.active[0, s]:
+                step = space.wrap(game.pos[0, :, s] - prev_pos[:, s], 1.0)
+                if abs(step).max() < 0.05:  # not a jump
+                    self.distance[s] += float(math.hypot(*step))
+
+    def finish(self, rules):
+        """Close the seats; return ``(result, replay)`` in ``spacewar.match``'s formats."""
+        from .replay import make_replay
+
+        outputs = [seat.close() for seat in self.seats]
+        result = match_result(self.game, self.names, self.seed, self.rounds, rules, self.faults,
+                              self.forfeits, outputs)
+        replay = make_replay(result, bytes(self.history), self.game.state_hash(0),
+                             faults=bytes(self.fault_codes), max_faults=self.max_faults)
+        return result, replay
 
 
-def _wrap(d):
-    return space.wrap(d, 1.0)
-
-
-def _blend(snapshot, game, prev_pos, prev_active, alpha):
-    """The snapshot with bodies moved ``alpha`` of the way from their previous position."""
-    pos = game.pos[0]
-    active = game.active[0]
-    moving = active & prev_active
-    step = _wrap(pos - prev_pos)
-    smooth = moving & (np.abs(step).max(axis=0) < 0.05)  # not a jump (hyperspace, new round)
-    blended = np.where(smooth, _wrap(prev_pos + alpha * step), pos)
-    # snapshot lists live torpedoes by body index, in order
-    live = [b for b in range(2, game.n_bodies) if active[b]]
-    for s in range(2):
-        if smooth[s]:
-            snapshot["ships"][s]["pos"] = [float(blended[0, s]), float(blended[1, s])]
-    for torpedo, b in zip(snapshot["torpedoes"], live):
-        if smooth[b]:
-            torpedo["pos"] = [float(blended[0, b]), float(blended[1, b])]
-    return snapshot
+# -- the sessions -------------------------------------------------------------------------------
+def _checked_rules(rules):
+    if rules is None:
+        return Rules()
+    if isinstance(rules, dict):
+        return Rules.from_dict(rules)
+    if not isinstance(rules, Rules):
+        raise TypeError(f"rules must be a spacewar.Rules or its dict, got {rules!r}")
+    return rules
 
 
 def play(p2="chaser", rules=None, seed=0, rounds=5, fps=60, scale=720, script=None,
-         max_seconds=None):
-    """A human (seat 0, the needle) against the bot ``p2`` (seat 1) in a pygame window.
+         max_seconds=None, *, p1=HUMAN, limits=None, max_faults=DEFAULT_MAX_FAULTS,
+         isolation="auto", record_to=None):
+    """Play a match in a pygame window; ``p1`` (the needle) and ``p2`` (the wedge) are each
+    ``"human"`` or a bot (a specification or a bot object). Default: you against the chaser.
 
-    ``rules``: a ``Rules`` (or its dict), default the 1962 game. ``fps``: game frames a
-    second. ``scale``: window side in pixels. ``script``: keys to play instead of the
-    keyboard (see ``script_source``), for tests and demos. ``max_seconds``: stop after that
-    much wall time. Returns a summary dict: ``reason`` (``over``, ``quit``, ``closed`` or
-    ``time``), ``scores`` [human, bot], ``frames`` played, ``rounds``, ``over``, ``winner``
-    (``human``, ``bot`` or None), per-seat ``torpedoes_fired``, ``distance`` flown (arena
-    units) and ``hyperspace_jumps``, the bot's ``bot_faults``, ``paused_frames``,
-    ``dropped_steps`` (frames the clock skipped because drawing fell behind) and
-    ``wall_seconds``.
+    ``rules``: a ``Rules`` (or its dict), default the 1962 game. ``fps``: game frames a second.
+    ``scale``: window side in pixels. ``script``: keys to play instead of the keyboard
+    (``script_source``), for tests and demos. ``max_seconds``: stop after that much wall time.
+    ``limits`` (``spacewar.seats.Limits``; default a 50 ms budget per action), ``max_faults``
+    and ``isolation``: the bots' budgets and seats, as in ``spacewar.match.play_match``.
+    ``record_to``: a replay file to write when the match is finished (its path is checked
+    first); a match left before its end is not written, since a replay records a whole match
+    (``spacewar replay --check`` refuses a record that stops early).
+    With no person in the match this is ``watch``.
+
+    Returns a summary dict: ``reason`` (``over``, ``quit``, ``closed``, ``time`` or
+    ``interrupted``), ``players``, ``scores``, ``frames`` played, ``rounds``, ``over``,
+    ``winner`` (with one person against one bot: ``human`` or ``bot``, as this function
+    always said; otherwise the winner's name in ``players``; None for none), ``winner_seat``,
+    ``forfeits``, per-seat
+    ``faults`` and ``torpedoes_fired``, ``distance`` flown (arena units) and
+    ``hyperspace_jumps``, ``bot`` (the bot's name when there is one bot), ``bot_faults`` and
+    ``bot_fault_examples`` (all bots'), ``paused_frames`` (window ticks spent paused),
+    ``dropped_steps`` (ticks the clock skipped because drawing fell behind), ``speed``,
+    ``wall_seconds``, ``result`` (``spacewar.match``'s result of the frames played),
+    ``replay_path`` (None when none was written) and ``replay_skipped`` (one was asked for
+    but the match was left before its end).
     """
-    if rules is None:
-        rules = Rules()
-    elif isinstance(rules, dict):
-        rules = Rules.from_dict(rules)
-    elif not isinstance(rules, Rules):
-        raise TypeError(f"rules must be a spacewar.Rules or its dict, got {rules!r}")
-    if isinstance(fps, bool) or not isinstance(fps, (int, float)) or not 1 <= fps <= 1000:
-        raise ValueError(f"fps must be a number in [1, 1000], got {fps!r}")
-    if isinstance(scale, bool) or not isinstance(scale, int) or scale < 128:
-        raise ValueError(f"scale must be an int >= 128 (pixels), got {scale!r}")
-    if max_seconds is not None and (isinstance(max_seconds, bool)
-                                    or not isinstance(max_seconds, (int, float))
-                                    or not max_seconds > 0):
-        raise ValueError(f"max_seconds must be None or a number > 0, got {max_seconds!r}")
-    source = None if script is None else script_source(script)
-    pygame = require_pygame()
-    from engine.clock import FixedStepClock
+    return _session((p1, p2), rules, seed, rounds, fps, scale, 1.0, script, max_seconds, limits,
+                    max_faults, isolation, record_to)
 
+
+def watch(p1="chaser", p2="sniper", rules=None, seed=0, rounds=5, fps=60, scale=720, speed=1.0,
+          script=None, max_seconds=None, *, limits=None, max_faults=DEFAULT_MAX_FAULTS,
+          isolation="auto", record_to=None):
+    """Watch bot ``p1`` (the needle) play bot ``p2`` (the wedge) in a pygame window.
+
+    Space or P pauses, ``.`` steps one frame, ``]``/``[`` (or Up/Down) go faster or slower
+    (``keys.SPEEDS``, 1/8x to 8x; ``speed`` is the one to start at), 1 is normal speed,
+    Esc or Q quits. The other arguments and the summary are ``play``'s; the match is the one
+    ``spacewar.match.play_match`` plays with the same bots and seed.
+    """
+    for s, spec in enumerate((p1, p2)):
+        if _is_human(spec):
+            raise ValueError(f"p{s + 1} is {spec!r}: watch is for two bots (people play with "
+                             "spacewar play)")
+    return _session((p1, p2), rules, seed, rounds, fps, scale, speed, script, max_seconds,
+                    limits, max_faults, isolation, record_to)
+
+
+def _session(specs, rules, seed, rounds, fps, scale, speed, script, max_seconds, limits,
+             max_faults, isolation, record_to):
+    """Check everything, open the seats and the window, run, close; return the summary."""
+    rules = _checked_rules(rules)
+    check_window_arguments(fps, scale, max_seconds)
+    speed = check_speed(speed)
+    limits = checked_limits(max_faults, BOT_BUDGET, limits)
+    watching = not any(_is_human(spec) for spec in specs)
+    known = K.WATCH_KEY_NAMES if watching else KEY_NAMES
+    source = None if script is None else K.script_source(script, known)
+    if record_to is not None:
+        record_to = check_output_path(record_to, "replay")  # before the match, not after it
+    check_display()  # before any bot starts
     game = Game(rules, seeds=[seed], rounds=rounds)  # checks seed and rounds
-    seat = open_seat(p2, bot_seed(seed, 1), Limits(budget=BOT_BUDGET), rules, rounds=rounds)
-    if getattr(seat, "wait_ready", None) is not None and seat.wait_ready() is not None:
-        seat.close()
-        raise ValueError(f"bot {p2!r} could not start: {seat.dead[1]}")
+    names = _people_names(specs)
+    seats = _open_seats(specs, names, seed, limits, rules, rounds, isolation)
+    match = LiveMatch(game, seats, names, seed, rounds, max_faults)
     try:
-        pygame.display.init()
-        pygame.font.init()
-        try:
-            screen = pygame.display.set_mode((scale, scale))
-        except pygame.error as exc:
-            raise RuntimeError(f"cannot open a game window: {exc} (is there a display? "
-                               "SDL_VIDEODRIVER=dummy runs without one)") from exc
-        pygame.display.set_caption(f"Spacewar! - you (needle) vs {p2} (wedge)")
-        return _run(pygame, screen, game, seat, p2, seed, rounds, fps, scale, source,
-                    max_seconds, FixedStepClock)
+        window = Window(scale, _caption(specs, names), known)
+    except BaseException:
+        match.finish(rules)
+        raise
+    finished = False
+    try:
+        pace = Pace(fps, speed)
+        session = LiveSession(match, pace, specs, watching, source is not None, window.size)
+        _, seconds = run_window(window, pace, session, source, max_seconds)
+        summary = {"reason": session.reason, "paused_frames": session.paused_ticks,
+                   "dropped_steps": pace.dropped_ticks, "speed": pace.speed,
+                   "wall_seconds": seconds}
+        result, replay = match.finish(rules)
+        finished = True
     finally:
-        seat.close()
-        pygame.display.quit()
-        pygame.font.quit()
+        if not finished:
+            match.finish(rules)
+        window.close()
+    written = record_to is not None and match.over
+    if written:
+        from .replay import save
+
+        save(record_to, replay)
+    return _summary(summary, match, result, specs, record_to if written else None,
+                    record_to is not None and not written)
 
 
-def _run(pygame, screen, game, seat, p2, seed, rounds, fps, scale, source, max_seconds,
-         FixedStepClock):
-    keycodes = _pygame_keys(pygame)
-    fonts = {}
-    effects = Effects()
-    effects.update(game.snapshot(0))
-    actions = np.full((1, 2), core.NOOP, dtype=np.int64)
-    fired = [0, 0]
-    distance = [0.0, 0.0]
-    jumps = [0, 0]
-    faults = 0
-    fault_examples = []
-    paused = False
-    paused_frames = 0
-    ticks = 0  # the clock's frames since the start, paused or not (a script's time line)
-    held = frozenset()
-    scripted_before = frozenset()
-    prev_pos = game.pos[0].copy()
-    prev_active = game.active[0].copy()
-    reason = None
-    help_lines = ["   ".join(f"{keys}: {what}" for keys, what in KEYS_HELP[:4]),
-                  "   ".join(f"{keys}: {what}" for keys, what in KEYS_HELP[4:])]
-    clock = FixedStepClock(dt=1.0 / fps, max_steps_per_frame=max(2, int(fps) // 10))
-    frame_limiter = pygame.time.Clock()
-    start = time.perf_counter()
-    clock.tick()  # starts the wall-time measurement
-    while reason is None:
-        pressed = set()
-        for event in pygame.event.get():
-            if event.type == pygame.QUIT:
-                reason = "closed"
-            elif event.type == pygame.KEYDOWN:
-                pressed.add(keycodes.get(event.key, "other"))
-        if QUIT in pressed:
-            reason = "quit"
-        if source is None:
-            state = pygame.key.get_pressed()
-            held = frozenset(name for code, name in keycodes.items() if state[code])
-            if PAUSE in pressed and not game.over[0]:
-                paused = not paused
-        if game.over[0]:
-            if source is not None or (pressed and reason is None):
-                reason = reason or "over"
-        for _ in range(clock.tick()):
-            if reason is not None:
+def _caption(specs, names):
+    shown = _screen_names(specs, names)
+    return f"Spacewar! - {shown[0]} (needle) vs {shown[1]} (wedge)"
+
+
+def _screen_names(specs, names):
+    """The names on screen: ``you`` for one person, ``player 1``/``player 2`` for two."""
+    people = [s for s, spec in enumerate(specs) if _is_human(spec)]
+    shown = list(names)
+    for s in people:
+        shown[s] = "you" if len(people) == 1 else f"player {s + 1}"
+    return shown
+
+
+# -- the loop -----------------------------------------------------------------------------------
+class LiveSession:
+    """A live match in the window (``viewer.run_window``'s session): the keys fly the people's
+    ships and control the session (pause and quit; while watching also single steps and the
+    speed), each window tick plays the frames it is worth, and the end waits for a key."""
+
+    def __init__(self, match, pace, specs, watching, scripted, size):
+        self.match = match
+        self.pace = pace
+        self.watching = watching
+        self.scripted = scripted
+        self.reason = None
+        self.paused_ticks = 0
+        self.held = frozenset()
+        self.names = _screen_names(specs, match.names)
+        self.footer_help = _footer_help(specs, watching, size)
+
+    def hold(self, held):
+        self.held = held
+
+    def click(self, x, y):
+        pass  # nothing to click on
+
+    def press(self, names):
+        quit_keys, pause_keys = (K.QUIT, K.PAUSE) if self.watching else (K.PLAY_QUIT, K.PLAY_PAUSE)
+        for name in sorted(names):
+            if name in quit_keys:
+                self.reason = "quit"
+            elif name in pause_keys:
+                self.pace.paused = not self.pace.paused
+            elif self.watching:
+                self._watch_key(name)
+        if self.match.over and names and self.reason is None:
+            self.reason = "over"  # any key closes the window at the end
+
+    def _watch_key(self, name):
+        pace = self.pace
+        if name in K.STEP_FORWARD:
+            pace.paused = True
+            if not self.match.over:
+                self.match.play_frame()
+        elif name in K.FASTER:
+            pace.faster()
+        elif name in K.SLOWER:
+            pace.slower()
+        elif name in K.NORMAL_SPEED:
+            pace.normal()
+
+    def tick(self):
+        """One window tick: nothing while paused, else the frames it is worth at the speed."""
+        match = self.match
+        if match.over:
+            if self.scripted:
+                self.reason = "over"  # no one to press a key
+            return
+        if self.pace.paused:
+            self.paused_ticks += 1
+            return
+        match.set_keys(self.held)
+        for _ in range(self.pace.frames()):
+            match.play_frame()
+            if match.over:
                 break
-            if source is not None:
-                held = source(ticks)
-                new = held - scripted_before
-                scripted_before = held
-                if QUIT in new:
-                    reason = "quit"
-                    break
-                if PAUSE in new:
-                    paused = not paused
-            ticks += 1
-            if game.over[0]:
-                break
-            if paused:
-                paused_frames += 1
-                continue
-            actions[0, 0] = action_code(held)
-            code, fault = seat.act(game.raw_observation(0, 1))
-            actions[0, 1] = code
-            if fault is not None:
-                faults += 1
-                if len(fault_examples) < 3:
-                    fault_examples.append({"frame": int(game.frame[0]), "kind": fault[0],
-                                           "message": fault[1]})
-            before_torps = game.ship_counters[0, :, core.TORPS].copy()
-            before_hyper = game.ship_counters[0, :, core.IN_HYPER].copy()
-            before_round = game.rounds_played(0)
-            prev_pos = game.pos[0].copy()
-            prev_active = game.active[0].copy()
-            game.step(actions)
-            if game.rounds_played(0) == before_round:
-                after_torps = game.ship_counters[0, :, core.TORPS]
-                for s in range(2):
-                    fired[s] += int(max(0, before_torps[s] - after_torps[s]))
-                    if game.ship_counters[0, s, core.IN_HYPER] and not before_hyper[s]:
-                        jumps[s] += 1
-                    if prev_active[s] and game.active[0, s]:
-                        step = _wrap(game.pos[0, :, s] - prev_pos[:, s])
-                        if abs(step).max() < 0.05:
-                            distance[s] += float(math.hypot(*step))
-            effects.update(game.snapshot(0))
-        if max_seconds is not None and time.perf_counter() - start >= max_seconds and reason is None:
-            reason = "time"
-        _draw(pygame, screen, fonts, game, effects, p2, rounds, clock, prev_pos, prev_active,
-              paused, help_lines, source is not None)
-        frame_limiter.tick(RENDER_CAP)
-    scores = [int(x) for x in game.scores[0]]
-    over = bool(game.over[0])
-    winner = None
-    if over and scores[0] != scores[1]:
-        winner = "human" if scores[0] > scores[1] else "bot"
-    return {"reason": reason, "scores": scores, "frames": int(game.frame[0]),
-            "rounds": game.rounds_played(0), "over": over, "winner": winner,
-            "torpedoes_fired": fired, "distance": distance, "hyperspace_jumps": jumps,
-            "bot": p2, "seed": seed, "bot_faults": faults, "bot_fault_examples": fault_examples,
-            "paused_frames": paused_frames, "dropped_steps": clock.dropped_steps,
-            "wall_seconds": time.perf_counter() - start}
+
+    def draw(self, window):
+        _draw(window, self)
 
 
-def _draw(pygame, screen, fonts, game, effects, p2, rounds, clock, prev_pos, prev_active,
-          paused, help_lines, scripted):
-    snapshot = game.snapshot(0)
-    if not paused and not snapshot["over"]:
-        snapshot = _blend(snapshot, game, prev_pos, prev_active, clock.alpha)
-    me = game.ship_counters[0, 0]
-    fuel = 100.0 * game.ship_gauges[0, 0, core.FUEL] / max(game.rules.fuel, 1e-300)
-    status = (f"fuel {fuel:3.0f}%   torpedoes {int(me[core.TORPS])}   "
-              f"hyperspace {int(me[core.HYPER_LEFT])}")
-    footer = [(status, SHIP_COLOURS[0])] + [(line, DIM_TEXT) for line in help_lines]
+def _footer_help(specs, watching, size):
+    """The keys, in short, along the bottom of the window."""
+    if watching:
+        return help_lines(WATCH_SCREEN_HELP, size)
+    keysets = _keysets(specs)
+    controls = (("P", "pause"), ("Esc", "quit"))
+    if len(keysets) == 1:
+        keyset = next(iter(keysets.values()))
+        return help_lines(keyset.help(short=True) + controls, size)
+    lines = []
+    for s, keyset in sorted(keysets.items()):
+        lines += help_lines(keyset.help(short=True), size, prefix=f"player {s + 1}:  ")
+    return lines + help_lines(controls, size)
+
+
+def _outcome(match, names):
+    """The end of the match in words: who won or forfeited."""
+    s0, s1 = (int(x) for x in match.game.scores[0])
+    if all(match.forfeits):
+        return "both forfeited"
+    if any(match.forfeits):
+        return f"{names[match.forfeits.index(True)]} forfeited"
+    people = match.people
+    if s0 == s1:
+        return f"a draw {s0}-{s1}"
+    winner = 0 if s0 > s1 else 1
+    if len(people) == 1:
+        return ("you win " if winner in people else "you lose ") + f"{max(s0, s1)}-{min(s0, s1)}"
+    return f"{names[winner]} wins {max(s0, s1)}-{min(s0, s1)}"
+
+
+def _draw(window, session):
+    """One picture of a live session: the game (blended towards the latest frame by the
+    clock's remainder), the keys and, while watching, the frame and the speed."""
+    match, pace = session.match, session.pace
+    game = match.game
+    snapshot = frame_snapshot(game)
+    if not pace.paused and not match.over and match.previous_positions is not None:
+        snapshot = blend(snapshot, game, *match.previous_positions, pace.alpha)
+    footer = []
+    if session.watching:
+        state = f"   speed {K.speed_label(pace.speed)}" + ("   paused" if pace.paused else "")
+        footer.append((f"frame {int(game.frame[0])}{state}", TEXT))
+    footer += [(line, DIM_TEXT) for line in session.footer_help]
     banner = None
-    if snapshot["over"]:
-        s0, s1 = snapshot["scores"]
-        outcome = "you win" if s0 > s1 else "you lose" if s1 > s0 else "a draw"
-        banner = f"game over: {outcome}" + ("" if scripted else " - press a key")
-    elif paused:
+    if match.over:
+        banner = "game over: " + _outcome(match, session.names)
+        if not session.scripted:
+            banner += " - press a key"
+    elif pace.paused and not session.watching:
         banner = "paused (P to resume)"
-    size = screen.get_width()
-    prims = scene(snapshot, size, effects=effects, names=("you", p2), rounds=rounds,
-                  footer=footer, banner=banner)
-    _paint(pygame, screen, prims, fonts)
-    pygame.display.flip()
+    window.show(scene(snapshot, window.size, effects=match.effects, names=session.names,
+                      rounds=match.rounds, footer=footer, banner=banner))
 
 
-__all__ = ["play", "action_code", "script_source", "KEYS_HELP", "KEY_NAMES", "require_pygame"]
+# -- the summary --------------------------------------------------------------------------------
+def _summary(run, match, result, specs, replay_path, replay_skipped):
+    people = [s for s, spec in enumerate(specs) if _is_human(spec)]
+    bots = [s for s in range(2) if s not in people]
+    winner_seat = result["winner_seat"]
+    if winner_seat is None:
+        winner = None
+    elif len(people) == 1 and len(bots) == 1:
+        winner = HUMAN if winner_seat in people else "bot"
+    else:
+        winner = match.names[winner_seat]
+    bot_examples = [ex for s in bots for ex in result["faults"][s]["examples"]][:3]
+    return {
+        "reason": run["reason"], "players": list(match.names), "scores": list(result["score"]),
+        "frames": result["steps"], "rounds": result["rounds"], "rounds_asked": match.rounds,
+        "over": bool(match.game.over[0]) or any(match.forfeits), "winner": winner,
+        "winner_seat": winner_seat, "forfeits": list(result["forfeits"]),
+        "faults": [result["faults"][s]["total"] for s in range(2)],
+        "torpedoes_fired": list(match.fired), "distance": list(match.distance),
+        "hyperspace_jumps": list(match.jumps), "seed": match.seed,
+        "mode": match.game.rules.mode,
+        "bot": match.names[bots[0]] if len(bots) == 1 else None,
+        "bot_faults": sum(result["faults"][s]["total"] for s in bots),
+        "bot_fault_examples": bot_examples,
+        "paused_frames": run["paused_frames"], "dropped_steps": run["dropped_steps"],
+        "speed": run["speed"], "wall_seconds": run["wall_seconds"], "result": result,
+        "replay_path": None if replay_path is None else str(replay_path),
+        "replay_skipped": replay_skipped,
+    }
+
+
+_ENDINGS = {"over": "the match is over", "quit": "quit before the end",
+            "closed": "window closed before the end", "time": "stopped at the time limit",
+            "interrupted": "interrupted (Ctrl-C) before the end"}
+
+
+def format_summary(summary):
+    """The summary of ``play``/``watch`` as a small table for people to read."""
+    result = summary["result"]
+    names = summary["players"]
+    rows = [("", "seat 1 (needle)", "seat 2 (wedge)"),
+            ("player", *names),
+            ("score", *map(str, summary["scores"])),
+            ("faults", *(_fault_cell(result["faults"][s]) for s in range(2))),
+            ("forfeited", *("yes" if f else "no" for f in summary["forfeits"])),
+            ("torpedoes fired", *map(str, summary["torpedoes_fired"])),
+            ("hyperspace jumps", *map(str, summary["hyperspace_jumps"])),
+            ("distance flown", *(f"{d:.2f}" for d in summary["distance"]))]
+    widths = [max(len(row[k]) for row in rows) for k in range(3)]
+    lines = ["  ".join(cell.ljust(widths[k]) for k, cell in enumerate(row)).rstrip()
+             for row in rows]
+    winner = summary["winner_seat"]
+    won = "none (a draw)" if winner is None else f"{names[winner]} (seat {winner + 1})"
+    if winner is None and all(summary["forfeits"]):
+        won = "none (both forfeited)"
+    lines.append("")
+    lines.append(f"winner: {won}   rounds: {summary['rounds']} of {summary['rounds_asked']}   "
+                 f"frames: {summary['frames']}   mode: {summary['mode']}   seed: {summary['seed']}")
+    lines.append(f"ended: {_ENDINGS.get(summary['reason'], summary['reason'])}   "
+                 f"paused {summary['paused_frames']} ticks, {summary['dropped_steps']} ticks "
+                 f"dropped, {summary['wall_seconds']:.1f} s")
+    if summary.get("replay_path"):
+        lines.append(f"replay written to {summary['replay_path']}")
+    elif summary.get("replay_skipped"):
+        lines.append("no replay written: the match was left before its end (a replay records "
+                     "a whole match)")
+    return "\n".join(lines)
+
+
+def _fault_cell(faults):
+    if not faults["total"]:
+        return "0"
+    kinds = ", ".join(f"{k} {faults[k]}" for k in FAULT_KINDS if faults.get(k))
+    return f"{faults['total']} ({kinds})"
+
+
+__all__ = ["play", "watch", "format_summary", "action_code", "script_source", "KeyboardSeat",
+           "LiveMatch", "LiveSession", "KEYS_HELP", "KEY_NAMES", "require_pygame"]

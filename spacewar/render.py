@@ -6,17 +6,23 @@
 The drawing has two halves. ``scene(snapshot, size, ...)`` turns the plain data of one frame
 (``Game.snapshot``) into a list of backend-neutral primitives in pixel coordinates: dots,
 rings, outlined and filled polygons, lines and text. ``render_frame`` paints that list with
-Pillow; the pygame window of ``spacewar.play`` paints the same list with pygame, so the
-GIF and the live game look alike.
+Pillow; the pygame window (``spacewar.viewer``, for ``play``, ``watch`` and ``replay --view``)
+paints the same list with pygame, so the GIF and the live game look alike.
 
 What is drawn: black space with a faint fixed star field, the central star as a flickering
 dot with rays (nothing when the rules have no star), the two ships as outlined shapes as in
 1962 (seat 0 the needle, seat 1 the wedge) turned to their heading with a flame behind a
-thrusting ship, torpedoes as dots in their owner's colour, expanding rings of debris where a
-ship died, a short flash where a ship jumps into or back out of hyperspace (a ship in
-hyperspace is not drawn), a small burst where a torpedo vanishes, and the names, scores and
-round at the top. Objects near an edge are also drawn on the opposite edge (the arena is a
-torus). Screen y points up, as the game's: a positive turn is anticlockwise on screen.
+thrusting ship, torpedoes as dots in their owner's colour (a few pixels across even in a
+480-pixel GIF), expanding rings of debris where a ship died, a short flash where a ship jumps
+into or back out of hyperspace (a ship in hyperspace is not drawn), a small burst where a
+torpedo vanishes, and the names, scores and round at the top. Objects near an edge are also
+drawn on the opposite edge (the arena is a torus). Screen y points up, as the game's: a
+positive turn is anticlockwise on screen.
+
+Given a snapshot from ``frame_snapshot(game)`` (``Game.snapshot`` plus the rules' capacities),
+the top also shows the mode and, for each ship, its fuel (as a percentage and a bar), its
+torpedoes and hyperspace jumps left and, in the electric mode, the sign of its charge (red +,
+blue -), also drawn beside the ship and as a ring round each torpedo.
 
 Pillow (and pygame for the window) are the optional ``[viz]`` extra; they are imported only
 when something is drawn.
@@ -43,6 +49,7 @@ STAR_RAYS = ((255, 255, 200), (255, 225, 130), (215, 175, 90))
 SKY = ((55, 55, 70), (85, 85, 100), (125, 125, 140))
 TEXT = (225, 225, 225)
 DIM_TEXT = (130, 130, 130)
+CHARGE_COLOURS = ((255, 85, 85), (90, 125, 255))  # positive, negative
 FIRE = ((255, 255, 255), (255, 245, 185), (255, 215, 100), (255, 160, 50), (235, 100, 35),
         (180, 60, 25), (120, 35, 15), (65, 18, 8))
 FADES = (1.0, 0.7, 0.45, 0.25)
@@ -62,6 +69,8 @@ TORPEDO_BURST_FRAMES = 8
 FINAL_HOLD_MS = 1500  # the last GIF frame stays up this long
 
 DEFAULT_NAMES = ("needle", "wedge")
+TORPEDO_RADIUS_PER_PIXEL = 1.0 / 190.0  # of the image side: 2.5 pixels at 480
+MIN_TORPEDO_RADIUS = 2.5  # pixels: a torpedo is a visible dot at any size
 
 
 def require_pillow():
@@ -180,6 +189,28 @@ class Effects:
 
     def current(self, frame):
         return [e for e in self.events if 0 <= frame - e[4] < self.LIFETIMES[e[0]]]
+
+
+# -- what a frame shows -------------------------------------------------------------------
+def frame_snapshot(game, m=0):
+    """``game.snapshot(m)`` with what the top of the screen shows beside it: ``mode``,
+    ``fuel_capacity``, ``torpedo_capacity``, ``hyperspace_capacity``, each ship's
+    ``hyperspace`` jumps left and each torpedo's ``charge``. Plain data, as the snapshot."""
+    from . import core
+
+    snap = game.snapshot(m)
+    rules = game.rules
+    snap["mode"] = rules.mode
+    snap["fuel_capacity"] = float(rules.fuel)
+    snap["torpedo_capacity"] = int(rules.torpedoes)
+    snap["hyperspace_capacity"] = int(rules.hyperspace_jumps)
+    for seat, ship in enumerate(snap["ships"]):
+        ship["hyperspace"] = int(game.ship_counters[m, seat, core.HYPER_LEFT])
+    # the snapshot lists the live torpedoes in body order
+    live = [b for b in range(2, game.n_bodies) if game.active[m, b]]
+    for torpedo, body in zip(snap["torpedoes"], live):
+        torpedo["charge"] = float(game.charge[m, body])
+    return snap
 
 
 # -- the scene ----------------------------------------------------------------------------
@@ -305,7 +336,110 @@ def _round_label(snapshot, rounds):
 
 
 def font_pixels(size):
+    """The score line's text height at an image of ``size`` pixels."""
     return max(10, size // 32)
+
+
+def footer_pixels(size):
+    """The footer's (and the ships' gauges') text height."""
+    return max(9, int(font_pixels(size) * 0.8))
+
+
+def footer_top(size, lines):
+    """The y pixel where a footer of ``lines`` lines starts (a window may draw above it)."""
+    return size - lines * footer_pixels(size) * 1.35 - font_pixels(size) * 0.5 * 0.3
+
+
+def hud_bottom(size):
+    """The y pixel below the top lines (score, and the gauges of a ``frame_snapshot``)."""
+    text_px = font_pixels(size)
+    return text_px * 0.3 + text_px * 1.45 + footer_pixels(size) * 1.35 + 6
+
+
+def _torpedoes(snapshot, size):
+    """Each torpedo as a dot in its owner's colour, ringed by its charge's in electric mode."""
+    radius = max(MIN_TORPEDO_RADIUS, size * TORPEDO_RADIUS_PER_PIXEL)
+    electric = snapshot.get("mode") == "electric"
+    prims = []
+    for torpedo in snapshot["torpedoes"]:
+        charge = torpedo.get("charge", 0.0) if electric else 0.0
+        for ix, iy in _images(*torpedo["pos"], 0.0):
+            px, py = to_pixels(ix, iy, size)
+            prims.append(("dot", px, py, radius, TORPEDO_COLOURS[torpedo["owner"]]))
+            if charge:
+                prims.append(("ring", px, py, radius + 1.5, CHARGE_COLOURS[charge < 0], 1))
+    return prims
+
+
+def _sign_glyph(x, y, half, charge):
+    """A plus or minus sign centred on (x, y), ``half`` pixels to each side, in the charge's
+    colour (drawn with lines, so it reads the same in every font and backend)."""
+    rgb = CHARGE_COLOURS[charge < 0]
+    width = 2 if half >= 3 else 1
+    prims = [("line", x - half, y, x + half, y, rgb, width)]
+    if charge > 0:
+        prims.append(("line", x, y - half, x, y + half, rgb, width))
+    return prims
+
+
+def _ship_charge(ship, size):
+    """The ship's charge sign just above and ahead of it on screen."""
+    if not ship.get("charge"):
+        return []
+    length = ship_length(size)
+    half = max(2.5, 0.16 * length * size)
+    prims = []
+    for ix, iy in _images(*ship["pos"], length):
+        px, py = to_pixels(ix, iy, size)
+        prims.extend(_sign_glyph(px + 0.7 * length * size, py - 0.7 * length * size, half,
+                                 ship["charge"]))
+    return prims
+
+
+def _gauges(ship, snapshot, size, seat):
+    """One ship's line under its name: fuel as text and a bar, torpedoes and hyperspace jumps
+    left (the jumps only where there is room), its charge sign in electric mode."""
+    text_px = font_pixels(size)
+    small = footer_pixels(size)
+    margin = text_px * 0.5
+    top = margin * 0.6 + text_px * 1.45
+    fraction = min(1.0, max(0.0, ship["fuel"] / max(snapshot["fuel_capacity"], 1e-300)))
+    text = f"fuel {100.0 * fraction:.0f}%  torp {ship['torpedoes']}"
+    if size >= 400 and "hyperspace" in ship:
+        text += f"  hyp {ship['hyperspace']}"
+    left = seat == 0
+    edge = margin if left else size - margin
+    inward = 1.0 if left else -1.0
+    prims = []
+    if snapshot["mode"] == "electric" and ship.get("charge"):
+        half = max(2.5, small * 0.3)
+        prims.extend(_sign_glyph(edge + inward * half, top + small * 0.55, half, ship["charge"]))
+        edge += inward * (2 * half + small * 0.5)
+    colour = SHIP_COLOURS[seat]
+    prims.append(("text", edge, top, text, colour, "left" if left else "right", small))
+    # the fuel bar under the text: outline, then the fuel left from the outer edge inwards
+    bar_top = top + small * 1.3
+    bar_height = max(2.0, small * 0.3)
+    width = size * 0.2
+    outer = margin if left else size - margin
+    inner = outer + inward * width
+    full = outer + inward * width * fraction
+    prims.append(("poly", [(outer, bar_top), (inner, bar_top), (inner, bar_top + bar_height),
+                           (outer, bar_top + bar_height)], _fade(colour, FADES[2]), 1))
+    if fraction > 0:
+        prims.append(("fill", [(outer, bar_top), (full, bar_top), (full, bar_top + bar_height),
+                               (outer, bar_top + bar_height)], colour))
+    return prims
+
+
+def _hud(snapshot, size):
+    """The mode in the middle and each ship's gauges under its name."""
+    text_px = font_pixels(size)
+    top = text_px * 0.3 + text_px * 1.45
+    prims = [("text", size / 2.0, top, snapshot["mode"], DIM_TEXT, "centre", footer_pixels(size))]
+    for seat, ship in enumerate(snapshot["ships"]):
+        prims.extend(_gauges(ship, snapshot, size, seat))
+    return prims
 
 
 def scene(snapshot, size, effects=None, names=None, rounds=None, footer=(), banner=None,
@@ -321,6 +455,9 @@ def scene(snapshot, size, effects=None, names=None, rounds=None, footer=(), bann
     ``effects``: an ``Effects`` fed every frame so far (hyperspace flashes, torpedo bursts);
     ``names``: the two players' names for the score line; ``rounds``: rounds asked for;
     ``footer``: lines ``(text, rgb)`` along the bottom; ``banner``: large text in the middle.
+    A snapshot from ``frame_snapshot`` (which has a ``mode``) also gets the mode and each
+    ship's gauges under the score line (``hud_bottom`` is where they end), and in the
+    electric mode the charge signs; a plain ``Game.snapshot`` gets the score line only.
     """
     prims = []
     frame = snapshot["frame"]
@@ -328,17 +465,17 @@ def scene(snapshot, size, effects=None, names=None, rounds=None, footer=(), bann
         prims.extend(_starfield(size))
     if snapshot.get("star"):
         prims.extend(_star(frame, size))
-    r_torpedo = max(1.5, size / 320.0)
-    for torpedo in snapshot["torpedoes"]:
-        for ix, iy in _images(*torpedo["pos"], 0.0):
-            px, py = to_pixels(ix, iy, size)
-            prims.append(("dot", px, py, r_torpedo, TORPEDO_COLOURS[torpedo["owner"]]))
+    prims.extend(_torpedoes(snapshot, size))
     for seat, ship in enumerate(snapshot["ships"]):
         if ship["alive"]:
             if not ship["in_hyperspace"]:
                 prims.extend(_ship(ship, seat, frame, size))
         elif ship.get("killed_at", -1) >= 0 and 0 <= frame - ship["killed_at"] < EXPLOSION_FRAMES:
             prims.extend(_explosion(ship, seat, frame - ship["killed_at"], size))
+    if snapshot.get("mode") == "electric":
+        for ship in snapshot["ships"]:
+            if ship["alive"] and not ship["in_hyperspace"]:
+                prims.extend(_ship_charge(ship, size))
     if effects is not None:
         for event in effects.current(frame):
             prims.extend(_flash(event, frame, size))
@@ -350,7 +487,9 @@ def scene(snapshot, size, effects=None, names=None, rounds=None, footer=(), bann
     prims.append(("text", margin, margin * 0.6, f"{names[0]}  {s0}", SHIP_COLOURS[0], "left", text_px))
     prims.append(("text", size - margin, margin * 0.6, f"{s1}  {names[1]}", SHIP_COLOURS[1], "right", text_px))
     prims.append(("text", size / 2.0, margin * 0.6, _round_label(snapshot, rounds), TEXT, "centre", text_px))
-    small = max(9, int(text_px * 0.8))
+    if "mode" in snapshot:
+        prims.extend(_hud(snapshot, size))
+    small = footer_pixels(size)
     for k, (text, rgb) in enumerate(reversed(list(footer))):
         prims.append(("text", size / 2.0, size - (k + 1) * small * 1.35 - margin * 0.3, text, rgb,
                       "centre", small))
@@ -371,6 +510,7 @@ def _build_palette():
     colours.extend(STAR_RAYS)
     colours.extend(SKY)
     colours.extend((TEXT, DIM_TEXT))
+    colours.extend(CHARGE_COLOURS)
     colours.extend(FIRE)
     for grey in (40, 90, 170, 255):
         colours.append((grey, grey, grey))
@@ -465,9 +605,9 @@ def new_image(size):
 
 
 def render_frame(snapshot, size=480, effects=None, names=None, rounds=None, footer=(), banner=None):
-    """One snapshot (``Game.snapshot(m)``) as a ``size`` x ``size`` Pillow image in 'P' mode
-    (a fixed 64-colour palette; ``.convert("RGB")`` for other uses). The other arguments are
-    those of ``scene``."""
+    """One snapshot (``frame_snapshot(game, m)``, or ``Game.snapshot(m)`` without the gauges)
+    as a ``size`` x ``size`` Pillow image in 'P' mode (a fixed 64-colour palette;
+    ``.convert("RGB")`` for other uses). The other arguments are those of ``scene``."""
     size = _check_size(size)
     image = new_image(size)
     return paint_pil(image, scene(snapshot, size, effects=effects, names=names, rounds=rounds,
@@ -600,7 +740,8 @@ def render_gif(replay, out_path, every=2, size=480, fps=30, max_frames=None):
             effects.update(snap)
             last["frame"] = snap["frame"]
             if snap["frame"] % every == 0 or snap["over"]:
-                writer.add(render_frame(snap, size, effects=effects, names=names, rounds=rounds))
+                writer.add(render_frame(frame_snapshot(game), size, effects=effects, names=names,
+                                        rounds=rounds))
                 if max_frames is not None and writer.added >= max_frames:
                     raise _Enough
 
@@ -616,5 +757,6 @@ def render_gif(replay, out_path, every=2, size=480, fps=30, max_frames=None):
             "game_frames": last["frame"], "size": size, "bytes": os.path.getsize(out_path)}
 
 
-__all__ = ["Effects", "render_frame", "render_gif", "scene", "paint_pil", "new_image",
-           "palette_index", "require_pillow", "to_pixels", "PALETTE", "VIZ_HINT"]
+__all__ = ["Effects", "render_frame", "render_gif", "scene", "frame_snapshot", "paint_pil",
+           "new_image", "palette_index", "require_pillow", "to_pixels", "footer_top",
+           "hud_bottom", "PALETTE", "VIZ_HINT"]

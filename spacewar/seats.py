@@ -13,7 +13,12 @@ fault as ``(kind, message)``:
   budget;
 - ``memory``: it ran out of its memory limit.
 
-Every fault costs the bot its turn (a no-op is played). A seat whose bot can no longer play
+Every fault costs the bot its turn (a no-op is played). Each seat keeps ``act_seconds``, the
+time of every action it was asked for: the wall-clock time from the question to the answer
+(what the budget is charged), the whole allowance when no answer came; a frame on which a
+confined bot was not asked, being still busy with an earlier one, is not listed. These are
+wall-clock figures, for ``play_match``'s ``timing`` and ``spacewar check``, never for a
+result. A seat whose bot can no longer play
 (start-up failure, death, protocol breach, stopped after hanging) sets ``seat.dead`` and the
 match forfeits it at once.
 
@@ -22,6 +27,7 @@ copy of the rules. ``ProcessSeat`` runs any other bot in its own confined proces
 (``spacewar.bothost``, ``spacewar.confinement``) and talks to it only in fixed-layout binary
 messages (``spacewar.wire``); the match never blocks on it: every wait has a deadline.
 """
+import array
 import dataclasses
 import functools
 import math
@@ -129,6 +135,7 @@ class InlineSeat:
             raise ValueError(f"inline seats are for built-in bots only, got {spec!r}: "
                              "other bots run in their own process")
         self.spec = spec
+        self.act_seconds = array.array("d")  # each action's time (see the module's text)
         self._rules = type(rules).from_dict(rules.to_dict())  # decodes; the bot never sees it
         self.rules = type(rules).from_dict(rules.to_dict())  # the bot may break only its own copy
         self.bank = _Bank(limits)
@@ -159,6 +166,7 @@ class InlineSeat:
         start = time.perf_counter()
         status, code, text = wire.ask(self.bot, obs)
         elapsed = time.perf_counter() - start
+        self.act_seconds.append(elapsed)
         if status in (wire.RAISED, wire.MEMORY):  # no answer at all: its time is not charged
             return codes.NOOP, (_KIND_BY_STATUS[status], text)
         if not self.bank.charge(elapsed):
@@ -206,6 +214,7 @@ class ProcessSeat:
 
     def __init__(self, spec, seed, limits, rules, cpu_seconds=None, rounds=None):
         self.spec = spec
+        self.act_seconds = array.array("d")  # each action's time (see the module's text)
         self.limits = limits
         self.bank = _Bank(limits)
         self.dead = None
@@ -320,6 +329,8 @@ class ProcessSeat:
     def _act(self, frame, raw):
         answer, fault, elapsed = self._exchange(frame, wire.pack_observe(frame, raw),
                                                 self.limits.budget, self.bank.allowance())
+        if elapsed is not None:  # None: not asked (dead, or still busy with an earlier frame)
+            self.act_seconds.append(elapsed)
         if answer is None:
             if elapsed is not None:  # silent for its whole allowance: the bank is spent
                 self.bank.left = 0.0

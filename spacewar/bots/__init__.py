@@ -3,6 +3,22 @@ a trained policy by its ``.npz`` file (``spacewar.policy.PolicyBot``).
 
 A bot is any class with ``act(self, obs) -> spacewar.Action``; it may define ``reset(self)``
 (called when a match starts) and accept a ``seed`` keyword (built-in bots do).
+
+How a specification is looked up, in this order (``locate``):
+
+1. a built-in name (``available()``): ``idle``, ``random``, ``chaser``, ``sniper``, ``dodger``;
+2. a name ending in ``.npz``: a trained policy file;
+3. ``where:Class`` with ``where`` ending in ``.py`` or holding a path separator: that file
+   (relative to the current directory);
+4. ``module:Class`` or ``package.module:Class``: the top-level module or package is looked
+   for first in the current directory (as ``python -m`` would find it), then on this
+   process's ``sys.path`` (installed packages, ``PYTHONPATH``); the bot's own process imports
+   it from exactly the directory found here. A module in the current directory may not take
+   the name of a standard-library module (it could not be told apart from it).
+
+The helpers of ``spacewar.bots.geometry`` that a bot needs first are also reachable from here
+(``from spacewar.bots import torus_delta, angle_diff``), loaded on first use: the engine they
+import is not loaded by importing this package.
 """
 import importlib
 import importlib.machinery
@@ -26,6 +42,20 @@ BUILTIN = {
 
 class BotLoadError(ValueError):
     """A bot specification that cannot be loaded (the message says why)."""
+
+
+#: ``spacewar.bots.geometry`` helpers re-exported here, imported on first use
+GEOMETRY_EXPORTS = ("wrap", "torus_delta", "torus_distance", "bearing", "angle_diff",
+                    "turn_towards", "steer", "heading_after", "periapsis", "safest_heading")
+
+
+def __getattr__(name):
+    # the geometry module loads the engine (numba): only a bot that uses it pays for that
+    if name in GEOMETRY_EXPORTS:
+        from . import geometry
+
+        return getattr(geometry, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def available():
@@ -65,10 +95,12 @@ def locate(spec):
     """Where a bot's code lives, found without running any of it.
 
     Returns ``(read_dirs, list_dirs, search_path)``: what its process must be able to read,
-    the directories it must be able to list to import it, and the directory to put first on
-    its ``sys.path`` (or None). Raises ``BotLoadError`` for a specification that cannot name
-    a bot: unknown name, missing file, module not found. Whether the module imports, and has
-    the class, is learnt in the bot's own process.
+    the directories it must be able to list to import it, and for a ``module:Class`` bot the
+    directory its top-level module was found in, which its process imports it from
+    (``import_top_level``), else None. The lookup order is the module docstring's. Raises
+    ``BotLoadError`` for a specification that cannot name a bot: unknown name, missing file,
+    module not found, a module in the current directory named like a standard-library one.
+    Whether the module imports, and has the class, is learnt in the bot's own process.
     """
     if is_policy_file(spec):
         path = os.path.abspath(spec)
@@ -90,6 +122,11 @@ def locate(spec):
     # finding a top-level module's spec runs none of its code
     found = importlib.machinery.PathFinder.find_spec(top, [os.getcwd()])
     local = found is not None
+    if local and top in sys.stdlib_module_names:
+        raise BotLoadError(f"the bot module {top!r} in the current directory has the name of a "
+                           f"standard-library module, which it cannot replace in the bot's "
+                           f"process: rename it, or name the file instead "
+                           f"(e.g. ./{top}.py:Class)")
     if found is None:
         try:
             found = importlib.util.find_spec(top)
@@ -105,7 +142,67 @@ def locate(spec):
     else:
         raise BotLoadError(f"module {top!r} for bot {spec!r} has no files to load")
     parents = sorted({os.path.dirname(os.path.abspath(r)) for r in roots})
-    return roots, parents, (parents[0] if local else None)
+    # a namespace package found on sys.path may have portions in several directories: the
+    # bot's process finds them all on its own path, as it always has
+    home = parents[0] if local or found.origin is not None else None
+    return roots, parents, home
+
+
+def import_top_level(spec, directory):
+    """Import the top-level module of the ``module:Class`` bot ``spec`` from exactly
+    ``directory`` (the bot's own process does this with ``locate``'s ``search_path``), so that
+    it is the very module the match found, wherever the process's own ``sys.path`` would look:
+    the current directory of the match, or a ``PYTHONPATH`` entry the bot's clean environment
+    does not have. The directory is first on ``sys.path`` while that import runs, and last
+    afterwards (so that it shadows nothing the bot imports later, while a namespace package's
+    portions, looked up on ``sys.path``, stay found). Raises
+    ``BotLoadError`` when the import fails, or when a module of that name is already loaded
+    from elsewhere (one the bot's host itself uses)."""
+    where, _ = _split(spec)
+    if is_builtin(spec) or _is_file_spec(where):
+        return None
+    top = where.split(".")[0]
+    module = sys.modules.get(top)
+    if module is None:
+        sys.path.insert(0, directory)
+        try:
+            module = importlib.import_module(top)
+        except ImportError as exc:
+            raise BotLoadError(f"cannot import module {top!r} for bot {spec!r} from "
+                               f"{directory!r}: {exc}") from exc
+        except Exception as exc:
+            raise BotLoadError(f"importing {top!r} failed: {type(exc).__name__}: {exc}") from exc
+        finally:
+            if directory in sys.path:
+                sys.path.remove(directory)
+            sys.path.append(directory)
+    if not _loaded_from(module, directory):
+        raise BotLoadError(f"module {top!r} for bot {spec!r} is already loaded from "
+                           f"{_module_location(module)!r}, not from {directory!r}: "
+                           "give your bot's module another name")
+    return module
+
+
+def _module_location(module):
+    """Where a loaded module's code is: its file, or its package directories."""
+    file = getattr(module, "__file__", None)
+    if file:
+        return os.path.abspath(file)
+    return ", ".join(os.path.abspath(p) for p in getattr(module, "__path__", ()))
+
+
+def _loaded_from(module, directory):
+    """Whether ``module`` (top-level) was loaded from a file or package in ``directory``
+    (for a namespace package: whether one of its portions is there)."""
+    directory = os.path.abspath(directory)
+
+    def inside(place):
+        return os.path.commonpath([os.path.abspath(place), directory]) == directory
+
+    file = getattr(module, "__file__", None)
+    if file:
+        return inside(file)
+    return any(inside(p) for p in getattr(module, "__path__", ()))
 
 
 MAX_SOURCE_BYTES = 1 << 20  # a bot's source read for act_batch; a larger one plays as act

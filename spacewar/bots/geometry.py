@@ -1,23 +1,38 @@
-"""Geometry and prediction the built-in bots share.
+"""Geometry and prediction for bots: the helpers the built-in bots use, public for yours.
 
-Conventions (see ``spacewar.rules``): the arena is the unit torus, coordinates in [-0.5, 0.5),
-the star sits at the origin, one time unit is one frame. Each frame the game applies
-``v += thrust + a_star(p)`` then ``p += v`` (symplectic Euler, kick then drift), with
-``a_star(p) = -mu p / (|p|^2 + eps^2)^(3/2)``, ``eps = star_capture / 2``.
+    from spacewar.bots.geometry import torus_delta, angle_diff, turn_towards
+
+Conventions (checked by ``tests/spacewar/test_bot_author.py``; see ``spacewar.rules``):
+
+* The arena is the unit torus: x and y in [-0.5, 0.5), y up; the star sits at the origin.
+  Leaving one edge brings a body back at the opposite one, so between two points there are
+  many straight paths (one per image); distances, hits and aiming use the shortest,
+  the *nearest image*: ``d = wrap(b - a)``.
+* One time unit is one frame. Each frame the game applies ``v += thrust + a_star(p)`` then
+  ``p += v`` (symplectic Euler, kick then drift), with
+  ``a_star(p) = -mu p / (|p|^2 + eps^2)^(3/2)``, ``eps = star_capture / 2``.
+* A heading is an angle in radians from the +x axis, anticlockwise positive, kept in
+  (-pi, pi]; a ship points (and thrusts, and fires) along ``(cos heading, sin heading)``.
+  ``Action(turn=+1)`` turns anticlockwise: the heading grows by ``rules.turn_rate`` a frame.
 
 What is here:
 
-* torus helpers: :func:`wrap`, :func:`torus_delta`, angles: :func:`angle_diff`;
+* torus helpers: :func:`wrap`, :func:`torus_delta`, :func:`torus_distance`; angles:
+  :func:`angle_diff`, :func:`bearing`;
 * steering: :func:`turn_towards` (fixed turn rate), :func:`steer` (also the angular-momentum
-  sense switch, where the keys change the angular velocity);
+  sense switch, where the keys change the angular velocity), :func:`heading_after`;
 * the star: :func:`star_accel`, :func:`periapsis` (closest distance to the star the coasting
   path will reach, from the conic's invariants), :func:`safest_heading` and
   :func:`safe_heading_near` (pick a thrust direction that keeps the periapsis high);
 * prediction: :func:`predict_path` (a coasting ship's positions at given frames, by
   ``engine.analytic.kepler`` about the star, or a straight line without a star),
-  :func:`torpedo_path`, :func:`lead_intercept` (the firing heading that meets a predicted
-  path), :func:`lead_straight` (the same for straight-line motion, in closed form),
-  :func:`first_hit` (would a torpedo on this heading hit, by the game's diamond test).
+  :func:`torpedo_path`, :func:`launch_state`, :func:`lead_intercept` (the firing heading that
+  meets a predicted path), :func:`lead_straight` (the same for straight-line motion, in closed
+  form), :func:`diamond_hits` and :func:`first_hit` (would a torpedo on this heading hit, by
+  the game's diamond test), :func:`ram_escape`; :func:`warm_up` loads the compiled kernels.
+
+Importing this module loads the engine (numba), about a second in a fresh process: a bot that
+uses it pays that once, at start-up, within its start-up budget.
 """
 import math
 
@@ -25,6 +40,13 @@ import numpy as np
 
 from engine import space
 from engine.analytic import kepler
+
+__all__ = [
+    "SIDE", "TWO_PI", "wrap", "torus_delta", "torus_distance", "angle_diff", "bearing",
+    "turn_towards", "steer", "heading_after", "star_accel", "periapsis", "safest_heading",
+    "safe_heading_near", "warm_up", "predict_path", "torpedo_path", "lead_intercept",
+    "lead_straight", "diamond_hits", "first_hit", "launch_state", "ram_escape",
+]
 
 #: side of the game's torus (positions in [-0.5, 0.5))
 SIDE = 1.0
@@ -34,24 +56,55 @@ TWO_PI = 2.0 * math.pi
 
 # -- torus and angles -------------------------------------------------------------------
 def wrap(x):
-    """Onto the torus coordinate range [-0.5, 0.5) (arrays or floats): ``engine.space.wrap``
-    with the game's side of 1."""
+    """``x`` (a float or an array of coordinates) mapped onto the torus range [-0.5, 0.5):
+    ``wrap(x) = x - floor(x + 1/2)`` (``engine.space.wrap`` with the game's side of 1).
+
+    ``wrap(0.7) == -0.3``; applied to a difference it gives the nearest image."""
     return space.wrap(x, SIDE)
 
 
 def torus_delta(a, b):
-    """The shortest vector from a to b on the unit torus (``engine.space.nearest_image``)."""
+    """The shortest vector from point ``a`` to point ``b`` on the unit torus, a (2,) array
+    (or (..., 2) for arrays of points): ``wrap(b - a)`` per coordinate, the nearest image
+    (``engine.space.nearest_image``). Each component is in [-0.5, 0.5).
+
+    Aim, distances and hits all use it: from (0.45, 0) the point (-0.45, 0) is 0.1 away
+    to the right, ``torus_delta((0.45, 0), (-0.45, 0)) == (0.1, 0)``, not 0.9 to the left."""
     return space.nearest_image(np.asarray(b, dtype=float) - np.asarray(a, dtype=float), SIDE)
 
 
+def torus_distance(a, b):
+    """The distance from ``a`` to ``b`` by the nearest image: ``|torus_delta(a, b)|``, at most
+    ``sqrt(2) / 2`` (a float)."""
+    d = torus_delta(a, b)
+    return math.hypot(float(d[0]), float(d[1]))
+
+
+def bearing(a, b):
+    """The heading (radians from +x, anticlockwise, in (-pi, pi]) that points from ``a`` to
+    ``b`` by the nearest image: ``atan2(d_y, d_x)`` with ``d = torus_delta(a, b)``."""
+    d = torus_delta(a, b)
+    return math.atan2(float(d[1]), float(d[0]))
+
+
 def angle_diff(target, heading):
-    """target - heading wrapped to (-pi, pi]."""
+    """The signed turn from ``heading`` to ``target`` (radians): ``target - heading`` wrapped
+    to (-pi, pi], ``((target - heading + pi) mod 2 pi) - pi`` with -pi taken as +pi.
+
+    Positive means the target is anticlockwise of the heading (turn +1 reaches it soonest),
+    negative clockwise (turn -1): ``angle_diff(0.1, -0.1) == 0.2``,
+    ``angle_diff(-3.1, 3.1)`` is about +0.083 (across the +-pi seam), never about -6.2."""
     d = (target - heading + math.pi) % TWO_PI - math.pi
     return d if d != -math.pi else math.pi
 
 
 def turn_towards(heading, target, rules, deadband=None):
-    """-1, 0 or +1: the turn that brings ``heading`` towards ``target`` fastest."""
+    """-1, 0 or +1: the turn that brings ``heading`` towards ``target`` fastest.
+
+    The sign of :func:`angle_diff` (``target``, ``heading``), or 0 when its size is within
+    ``deadband`` (default half of ``rules.turn_rate``, the heading's step in a frame, so the
+    ship does not wobble one step either side of the target). Under the angular-momentum
+    switch use :func:`steer`."""
     d = angle_diff(target, heading)
     band = 0.5 * rules.turn_rate if deadband is None else deadband
     if abs(d) <= band:
@@ -81,7 +134,11 @@ def steer(ship, target, rules):
 
 
 def heading_after(ship, turn, rules):
-    """The heading the ship will have once this frame's ``turn`` is applied (fire uses it)."""
+    """The heading the ship will have once this frame's ``turn`` is applied, which is the
+    heading a torpedo fired this frame leaves on (the game turns, then thrusts, then fires):
+    ``heading + turn turn_rate``, or with angular momentum ``heading + w'`` where
+    ``w' = clip(w + turn angular_accel, -4 turn_rate, 4 turn_rate)``. Not wrapped to
+    (-pi, pi]: compare it with :func:`angle_diff`."""
     if rules.angular_momentum:
         limit = 4.0 * rules.turn_rate
         w = min(limit, max(-limit, ship.angular_velocity + turn * rules.angular_accel))
@@ -275,7 +332,9 @@ def lead_straight(shooter_pos, shooter_vel, target_pos, target_vel, offset, spee
 
 
 def diamond_hits(rel, box, diamond):
-    """The game's hit test on relative positions ``rel`` (..., 2), already nearest-image."""
+    """The game's hit test on relative positions ``rel`` (..., 2), already nearest-image:
+    ``|dx| < box and |dy| < box and |dx| + |dy| < diamond`` (the 1962 program's diamond;
+    ``rules.hit_box`` 12 points, ``rules.hit_diamond`` 18)."""
     ax = np.abs(rel[..., 0])
     ay = np.abs(rel[..., 1])
     return (ax < box) & (ay < box) & (ax + ay < diamond)
@@ -292,7 +351,9 @@ def first_hit(launch_pos, launch_vel, target_path, times, rules, mu, shrink=1.0)
 
 
 def launch_state(ship, heading, rules):
-    """Where a torpedo fired now on ``heading`` starts, and its velocity (as ``core._fire``)."""
+    """Where a torpedo fired now on ``heading`` starts, and its velocity (as the game's
+    ``core._fire``): ``p0 = pos + launch_offset u``, ``v0 = vel + muzzle_speed u`` with
+    ``u = (cos heading, sin heading)``. Returns ``(p0, v0)``, p0 not wrapped."""
     c, s = math.cos(heading), math.sin(heading)
     p0 = np.array([ship.pos[0] + rules.launch_offset * c, ship.pos[1] + rules.launch_offset * s])
     v0 = np.array([ship.vel[0] + rules.muzzle_speed * c, ship.vel[1] + rules.muzzle_speed * s])

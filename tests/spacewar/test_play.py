@@ -1,4 +1,4 @@
-"""Tests for spacewar.play: the human-against-bot window, run headless with scripted keys."""
+"""Tests for spacewar.play: people and bots in the window, run headless with scripted keys."""
 import os
 
 os.environ["SDL_VIDEODRIVER"] = "dummy"
@@ -9,9 +9,20 @@ import pytest  # noqa: E402
 
 pygame = pytest.importorskip("pygame")
 
+from spacewar import keys as K  # noqa: E402
 from spacewar import play as play_module  # noqa: E402
-from spacewar.play import action_code, play, script_source  # noqa: E402
+from spacewar import replay as replay_io  # noqa: E402
+from spacewar.match import play_match  # noqa: E402
+from spacewar.play import action_code, format_summary, play, script_source, watch  # noqa: E402
 from spacewar.protocol import Action  # noqa: E402
+from spacewar.rules import Rules  # noqa: E402
+
+
+@pytest.fixture(scope="module", autouse=True)
+def compiled_frames():
+    """The compiled frame is compiled (or loaded from the cache) before any test runs against
+    the wall clock, so a first-time compile never eats a test's time limit."""
+    play_match("chaser", "sniper", rounds=1, rules=Rules(max_round_frames=20, post_round_delay=2))
 
 
 def test_keys_to_actions():
@@ -125,3 +136,256 @@ def test_missing_pygame_says_how_to_install(monkeypatch):
     monkeypatch.setitem(sys.modules, "pygame", None)
     with pytest.raises(ImportError, match=r"\.\[viz\]"):
         play_module.require_pygame()
+
+
+# -- two people, one person in either seat ----------------------------------------------------
+def recorded_codes(path):
+    """The (frames, 2) action codes of a replay file the window recorded."""
+    return replay_io.actions(replay_io.load(path))
+
+
+def test_two_people_at_one_keyboard_each_fly_their_own_ship(tmp_path):
+    path = tmp_path / "two.json"
+    script = [(0, {"w", "left", "down"}),  # player 1 thrusts; player 2 turns left and fires
+              (30, {"a", "kp8", "rctrl"}),  # player 1 turns; player 2 on the keypad and RCtrl
+              (60, {"e", "rshift"}),  # both jump to hyperspace
+              (61, set())]
+    # short rounds, so that the match ends by itself at 2 x 100 frames and is recorded
+    rules = Rules(max_round_frames=100, post_round_delay=0)
+    result = play(p1="human", p2="human", rules=rules, rounds=2, script=script, max_seconds=60,
+                  scale=256, record_to=path)
+    assert result["reason"] == "over" and result["replay_path"] == str(path)
+    assert result["players"] == ["human 1", "human 2"] and result["bot"] is None
+    codes = recorded_codes(path)
+    assert codes.shape == (result["frames"], 2) and result["frames"] >= 70
+    assert set(codes[:30, 0]) == {Action(thrust=True).code()}
+    assert set(codes[:30, 1]) == {Action(turn=1, fire=True).code()}  # arrows are player 2's
+    assert set(codes[30:60, 0]) == {Action(turn=1).code()}
+    assert set(codes[30:60, 1]) == {Action(thrust=True, fire=True).code()}
+    assert list(codes[60]) == [Action(hyperspace=True).code()] * 2
+    assert result["hyperspace_jumps"] == [1, 1]
+    assert result["torpedoes_fired"][1] >= 2 and result["torpedoes_fired"][0] == 0
+
+
+def test_one_person_in_seat_2_gets_both_hands_keys(tmp_path):
+    path = tmp_path / "seat2.json"
+    rules = Rules(max_round_frames=40, post_round_delay=0)
+    result = play(p1="idle", p2="human", rules=rules, rounds=1, script=[(0, {"left", "w"})],
+                  max_seconds=60, scale=256, record_to=path)
+    assert result["players"] == ["idle", "human"] and result["bot"] == "idle"
+    codes = recorded_codes(path)
+    assert set(codes[:, 1]) == {Action(turn=1, thrust=True).code()}
+    assert set(codes[:, 0]) == {Action().code()}
+    assert replay_io.check(replay_io.load(path))[0]
+
+
+def test_a_match_left_before_its_end_writes_no_replay(tmp_path):
+    path = tmp_path / "left.json"
+    result = play(p2="idle", script=[(0, {"w"}), (30, {"escape"})], max_seconds=20, scale=256,
+                  record_to=path)
+    assert result["reason"] == "quit" and result["replay_path"] is None
+    assert result["replay_skipped"] and not path.exists()
+    assert "no replay written: the match was left before its end" in format_summary(result)
+
+
+@pytest.mark.parametrize("keyset, key, action", [
+    (K.PLAYER_1, "a", Action(turn=1)), (K.PLAYER_1, "d", Action(turn=-1)),
+    (K.PLAYER_1, "w", Action(thrust=True)), (K.PLAYER_1, "space", Action(fire=True)),
+    (K.PLAYER_1, "s", Action(fire=True)), (K.PLAYER_1, "e", Action(hyperspace=True)),
+    (K.PLAYER_1, "f", Action(flip=True)), (K.PLAYER_1, "left", Action()),
+    (K.PLAYER_2, "left", Action(turn=1)), (K.PLAYER_2, "kp6", Action(turn=-1)),
+    (K.PLAYER_2, "up", Action(thrust=True)), (K.PLAYER_2, "kp5", Action(fire=True)),
+    (K.PLAYER_2, "down", Action(fire=True)), (K.PLAYER_2, "kp0", Action(hyperspace=True)),
+    (K.PLAYER_2, "return", Action(flip=True)), (K.PLAYER_2, "kp_enter", Action(flip=True)),
+    (K.PLAYER_2, "w", Action()), (K.SOLO, "h", Action(hyperspace=True)),
+])
+def test_each_key_set(keyset, key, action):
+    assert action_code(frozenset({key}), keyset) == action.code()
+    both_turns = keyset.left | keyset.right
+    assert action_code(frozenset(both_turns), keyset) == Action(hyperspace=True).code()
+
+
+def test_the_key_sets_do_not_share_a_key():
+    assert not K.PLAYER_1.names & K.PLAYER_2.names
+    assert not (K.PLAYER_1.names | K.PLAYER_2.names) & (K.PLAY_PAUSE | K.PLAY_QUIT)
+
+
+# -- watching two bots --------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def watched(tmp_path_factory):
+    path = tmp_path_factory.mktemp("watch") / "watched.json"
+    summary = watch("chaser", "sniper", seed=7, rounds=1, fps=240, speed=8.0, scale=256,
+                    script=[], max_seconds=120, record_to=path)
+    return summary, path
+
+
+def test_watch_plays_the_match_spacewar_match_plays(watched):
+    summary, path = watched
+    assert summary["reason"] == "over" and summary["over"]
+    result, rep, _ = play_match("chaser", "sniper", seed=7, rounds=1, record=True)
+    assert summary["result"] == result
+    assert summary["scores"] == result["score"] and summary["frames"] == result["steps"]
+    saved = replay_io.load(path)
+    assert saved["actions"] == rep["actions"]
+    assert saved["final_state_sha256"] == rep["final_state_sha256"]
+    ok, details = replay_io.check(saved)
+    assert ok, details
+
+
+def test_the_summary_is_a_table(watched):
+    summary, path = watched
+    text = format_summary(summary)
+    lines = text.splitlines()
+    assert lines[0].split() == ["seat", "1", "(needle)", "seat", "2", "(wedge)"]
+    assert lines[1].split() == ["player", "chaser", "sniper"]
+    assert lines[2].split() == ["score", *map(str, summary["scores"])]
+    assert lines[3].split() == ["faults", "0", "0"]
+    winner = summary["winner_seat"]
+    expected = ("none (a draw)" if winner is None else
+                f"{summary['players'][winner]} (seat {winner + 1})")
+    assert f"winner: {expected}" in text
+    assert f"rounds: {summary['rounds']} of 1" in text and f"frames: {summary['frames']}" in text
+    assert "ended: the match is over" in text and f"replay written to {path}" in text
+    assert "{" not in text
+
+
+def test_a_bot_from_elsewhere_plays_confined_exactly_as_in_a_match(monkeypatch):
+    from spacewar.seats import InlineSeat, ProcessSeat
+
+    opened = []
+    real_open = play_module.open_seat
+
+    def spy(*args, **kwargs):
+        opened.append(real_open(*args, **kwargs))
+        return opened[-1]
+
+    monkeypatch.setattr(play_module, "open_seat", spy)
+    spec = "tests.spacewar.bots_for_tests:SometimesRaising"  # faults on frames 5, 6 and 7
+    summary = watch(spec, "idle", seed=3, rounds=1, fps=240, speed=8.0, scale=256, script=[],
+                    max_seconds=120)
+    assert isinstance(opened[0], ProcessSeat) and isinstance(opened[1], InlineSeat)
+    result, _, _ = play_match(spec, "idle", seed=3, rounds=1)
+    assert summary["result"] == result
+    assert summary["faults"] == [3, 0] and summary["bot_faults"] == 3
+    assert [ex["frame"] for ex in result["faults"][0]["examples"]] == [5, 6, 7]
+
+
+def test_a_bot_that_faults_too_often_forfeits_the_watched_match():
+    spec = "tests.spacewar.bots_for_tests:Raising"
+    summary = watch(spec, "chaser", seed=1, rounds=1, max_faults=3, fps=240, scale=256,
+                    script=[], max_seconds=120)
+    assert summary["reason"] == "over" and summary["forfeits"] == [True, False]
+    assert summary["winner_seat"] == 1 and summary["frames"] == 2
+    result, _, _ = play_match(spec, "chaser", seed=1, rounds=1, max_faults=3)
+    assert summary["result"] == result
+    assert "yes" in format_summary(summary).splitlines()[4]  # the forfeited row
+
+
+def test_watch_pauses_steps_and_changes_speed():
+    script = [(10, {"space"}), (11, set()), (12, {"."}), (13, set()), (14, {"."}),
+              (15, set()), (20, {"p"}), (21, set()), (30, {"]"}), (31, set()),
+              (40, {"["}), (41, set()), (42, {"["}), (43, set()), (44, {"1"}), (45, set()),
+              (50, {"q"})]
+    result = watch("chaser", "idle", script=script, fps=240, max_seconds=30, scale=256)
+    assert result["reason"] == "quit"
+    # ticks 0..9: 10 frames; paused for ticks 10..19 with 2 single steps; ticks 20..29: 10
+    # frames; 30..39 at 2x: 20; 40..41 at 1x: 2; 42..43 at 1/2x: 1; 44..49 at 1x: 6
+    assert result["paused_frames"] == 10
+    assert result["frames"] == 10 + 2 + 10 + 20 + 2 + 1 + 6
+    assert result["speed"] == 1.0
+
+
+def test_watch_is_for_bots_and_checks_its_speed():
+    with pytest.raises(ValueError, match="watch is for two bots"):
+        watch("human", "chaser")
+    with pytest.raises(ValueError, match="speed must be one of"):
+        watch("chaser", "idle", speed=3)
+    with pytest.raises(ValueError, match="unknown key"):
+        watch("chaser", "idle", script=[(0, {"w"})])  # a flying key means nothing here
+
+
+# -- no display, the command line -----------------------------------------------------------------
+@pytest.mark.parametrize("argv", [["play"], ["play", "--p1", "human", "--p2", "human"],
+                                  ["watch", "--p1", "chaser", "--p2", "sniper"]])
+def test_no_display_is_one_line_and_exit_status_2(argv, monkeypatch, capsys):
+    from spacewar.cli import main
+
+    for name in ("DISPLAY", "WAYLAND_DISPLAY", "SDL_VIDEODRIVER"):
+        monkeypatch.delenv(name, raising=False)
+    opened = []
+    monkeypatch.setattr(play_module, "open_seat", lambda *a, **k: opened.append(a))
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert err.startswith(f"spacewar {argv[0]}: no display: DISPLAY and WAYLAND_DISPLAY")
+    assert opened == []  # found out before any bot started
+
+
+def test_a_video_driver_that_fails_is_the_same_clear_error(monkeypatch, capsys):
+    from spacewar.cli import main
+
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    monkeypatch.setenv("SDL_VIDEODRIVER", "x11")
+    assert main(["watch", "--p1", "idle", "--p2", "idle"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("spacewar watch: cannot open a window:") and err.count("\n") == 1
+
+
+def test_a_display_that_is_not_there_is_not_drawn_to_invisibly(monkeypatch, capfd):
+    from spacewar.cli import main
+
+    monkeypatch.delenv("SDL_VIDEODRIVER", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    monkeypatch.setenv("DISPLAY", ":987")  # no X server there: SDL would fall back silently
+    assert main(["watch", "--p1", "idle", "--p2", "idle"]) == 2
+    ours = [line for line in capfd.readouterr().err.splitlines() if line.startswith("spacewar")]
+    assert len(ours) == 1
+    assert ours[0].startswith(("spacewar watch: no display: SDL found none it can use",
+                               "spacewar watch: cannot open a window:"))
+
+
+def test_help_lists_the_keys_and_the_defaults(capsys):
+    from spacewar.cli import main
+
+    for command, expected in (
+            ("play", ["Keys, one person", "A/D or Left/Right", "Kp8", "RShift", "(default: human)",
+                      "(default: chaser)", "(default: 720)", "(default: 50.0)"]),
+            ("watch", ["Keys while watching", "(default: sniper)", "(default: 1.0)", "1/8x to 8x"]),
+            ("replay", ["Keys of the replay window", "hold R or Backspace", "(default: 480)"])):
+        with pytest.raises(SystemExit):
+            main([command, "--help"])
+        out = capsys.readouterr().out
+        for text in expected:
+            assert text in out, (command, text)
+
+
+def test_watch_from_the_command_line_to_the_end(tmp_path, monkeypatch, capsys):
+    from spacewar import viewer
+    from spacewar.cli import main
+
+    real_poll = viewer.Window.poll
+
+    def poll(self):  # a key is pressed all the time: at the end it closes the window
+        pressed, clicks, closed = real_poll(self)
+        return pressed | {"other"}, clicks, closed
+
+    monkeypatch.setattr(viewer.Window, "poll", poll)
+    path = tmp_path / "cli.json"
+    assert main(["watch", "--p1", "chaser", "--p2", "idle", "--rounds", "1", "--speed", "8",
+                 "--fps", "500", "--window-size", "200", "--replay", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert out.splitlines()[1].split() == ["player", "chaser", "idle"]
+    assert "ended: the match is over" in out
+    assert replay_io.check(replay_io.load(path))[0]
+
+
+def test_a_bad_replay_path_is_refused_before_anything_starts(tmp_path, monkeypatch, capsys):
+    from spacewar.cli import main
+
+    opened = []
+    monkeypatch.setattr(play_module, "open_seat", lambda *a, **k: opened.append(a))
+    (tmp_path / "keep.gif").write_bytes(b"GIF89a" + bytes(20))
+    assert main(["watch", "--replay", str(tmp_path / "keep.gif")]) == 2
+    assert "gif" in capsys.readouterr().err.lower() and opened == []
+    assert (tmp_path / "keep.gif").read_bytes().startswith(b"GIF89a")

@@ -224,3 +224,110 @@ def test_single_frame_gif(tmp_path, replay):
     assert info["frames"] == 1
     with Image.open(out) as im:
         assert im.n_frames == 1 and im.size == (SIZE, SIZE)
+
+
+# -- what the top of the screen shows (frame_snapshot) ----------------------------------------
+def played(rules, frames=90, seed=3):
+    """A game after both ships thrusted and fired for ``frames`` frames (ship 1 flips its
+    charge first in the electric mode)."""
+    from spacewar.protocol import Action
+
+    game = Game(rules, seeds=[seed], rounds=2)
+    for i in range(frames):
+        game.step([[Action(turn=1, thrust=True, fire=True),
+                    Action(fire=True, thrust=i < 40, flip=i == 0 and rules.mode == "electric")]])
+    return game
+
+
+def rgb(image):
+    return np.asarray(image.convert("RGB"))
+
+
+def mask(pixels, colour):
+    return (pixels == colour).all(axis=2)
+
+
+def test_frame_snapshot_adds_what_the_gauges_need():
+    game = played(Rules(mode="electric"))
+    snap = render.frame_snapshot(game)
+    assert snap["mode"] == "electric" and snap["fuel_capacity"] == game.rules.fuel
+    assert snap["torpedo_capacity"] == 32 and snap["hyperspace_capacity"] == 8
+    assert [s["hyperspace"] for s in snap["ships"]] == [8, 8]
+    assert snap["torpedoes"] and all(t["charge"] != 0 for t in snap["torpedoes"])
+    # a torpedo carries its launcher's charge: ship 1 flipped before it fired, so the charges
+    # of both ships' torpedoes have the same sign
+    signs = {t["owner"]: np.sign(t["charge"]) for t in snap["torpedoes"]}
+    assert signs[0] == signs[1] == np.sign(snap["ships"][0]["charge"])
+    base = game.snapshot(0)
+    assert {k: v for k, v in snap.items() if k in base and k not in ("ships", "torpedoes")} == \
+        {k: v for k, v in base.items() if k not in ("ships", "torpedoes")}
+
+
+def test_the_gauges_show_mode_fuel_torpedoes_and_charge():
+    size = 480
+    top = int(render.hud_bottom(size))
+    game = played(Rules(mode="electric"))
+    electric = rgb(render_frame(render.frame_snapshot(game), size))[:top]
+    plain = rgb(render_frame(game.snapshot(0), size))[:top]
+    # the gauges line: text in both ships' colours under the score line
+    line = slice(int(render.font_pixels(size) * 1.6), top)
+    for seat, colour in enumerate(render.SHIP_COLOURS):
+        half = electric[line, :size // 2] if seat == 0 else electric[line, size // 2:]
+        assert mask(half, colour).sum() > 40
+        assert mask(plain[line], colour).sum() == 0
+    # the mode's name in the middle, the charge signs (a plus and a minus) at the edges
+    middle = electric[line, size // 2 - 40:size // 2 + 40]
+    assert mask(middle, render.DIM_TEXT).sum() > 20
+    plus, minus = render.CHARGE_COLOURS
+    assert mask(electric[line, :40], plus).sum() >= 8  # ship 0 is positive
+    assert mask(electric[line, -40:], plus).sum() + mask(electric[line, -40:], minus).sum() >= 4
+    classic = rgb(render_frame(render.frame_snapshot(played(Rules())), size))[:top]
+    assert not mask(classic, plus).any() and not mask(classic, minus).any()
+
+
+def test_the_fuel_bar_is_as_long_as_the_fuel_left():
+    size = 480
+    snap = render.frame_snapshot(Game(Rules(), seeds=[1]))
+    lengths = {}
+    for fraction in (1.0, 0.5, 0.25):
+        snap["ships"][0]["fuel"] = fraction * snap["fuel_capacity"]
+        pixels = rgb(render_frame(snap, size))
+        rows = mask(pixels[:int(render.hud_bottom(size))], render.SHIP_COLOURS[0])
+        bar_row = rows[int(render.font_pixels(size) * 1.75 + render.footer_pixels(size) * 1.3) + 1]
+        lengths[fraction] = int(bar_row.sum())
+    full = 0.2 * size  # the bar is a fifth of the image wide
+    for fraction, length in lengths.items():
+        assert abs(length - fraction * full) <= 2, lengths
+
+
+def test_torpedoes_are_visible_dots_at_480_pixels():
+    snap = render.frame_snapshot(Game(Rules(), seeds=[3]))
+    snap["torpedoes"] = [{"pos": [0.2, -0.2], "owner": 0, "charge": 0.0}]
+    pixels = rgb(render_frame(snap, 480))
+    dot = mask(pixels, render.TORPEDO_COLOURS[0])
+    assert dot.sum() >= 16  # about 5 pixels across, not one
+    rows, cols = np.nonzero(dot)
+    assert rows.max() - rows.min() >= 4 and cols.max() - cols.min() >= 4
+    x, y = render.to_pixels(0.2, -0.2, 480)
+    assert abs(rows.mean() - y) < 1 and abs(cols.mean() - x) < 1
+
+
+def test_electric_torpedoes_wear_their_charge():
+    snap = render.frame_snapshot(Game(Rules(mode="electric"), seeds=[3]))
+    snap["torpedoes"] = [{"pos": [0.2, -0.2], "owner": 1, "charge": -4e-4}]
+    pixels = rgb(render_frame(snap, 480))
+    x, y = (int(round(v)) for v in render.to_pixels(0.2, -0.2, 480))
+    around = pixels[y - 8:y + 9, x - 8:x + 9]
+    assert mask(around, render.CHARGE_COLOURS[1]).sum() >= 8
+    assert mask(around, render.TORPEDO_COLOURS[1]).sum() >= 12
+
+
+def test_the_gif_shows_the_gauges(tmp_path):
+    _, rep, _ = play_match("chaser", "sniper", seed=2, rounds=1, rules=Rules(mode="electric"),
+                           record=True)
+    out = tmp_path / "electric.gif"
+    render_gif(rep, out, size=480, max_frames=40)
+    last = frames_of(out)[-1][:int(render.hud_bottom(480))]
+    for colour in render.SHIP_COLOURS:
+        assert mask(last, colour).sum() > 100
+    assert mask(last, render.CHARGE_COLOURS[0]).any() and mask(last, render.CHARGE_COLOURS[1]).any()

@@ -103,3 +103,24 @@ def test_help_of_every_command_shows_the_defaults():
                               capture_output=True, text=True, check=True).stdout
         if command in ("match", "tournament"):
             assert "(default: 50.0)" in text and "(default: 1000.0)" in text
+
+
+def test_every_subcommand_s_help_shows_its_options_defaults():
+    """``spacewar CMD --help`` prints "(default: ...)" for every option that has a default."""
+    import argparse
+
+    from spacewar.cli import build_parser
+
+    parser = build_parser()
+    commands = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    missing = []
+    for name, sub in commands.choices.items():
+        text = " ".join(sub.format_help().split())
+        for action in sub._actions:
+            if (not action.option_strings or action.help == argparse.SUPPRESS
+                    or action.default in (None, False, argparse.SUPPRESS)):
+                continue
+            shown = " ".join(f"(default: {action.default})".split())
+            if shown not in text:
+                missing.append(f"{name} {action.option_strings[0]} (default {action.default!r})")
+    assert not missing, "defaults not shown in --help: " + ", ".join(missing)
