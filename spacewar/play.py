@@ -411,12 +411,8 @@ class LiveSession:
             pace.paused = True
             if not self.match.over:
                 self.match.play_frame()
-        elif name in K.FASTER:
-            pace.faster()
-        elif name in K.SLOWER:
-            pace.slower()
-        elif name in K.NORMAL_SPEED:
-            pace.normal()
+        else:
+            pace.speed_key(name)
 
     def tick(self):
         """One window tick: nothing while paused, else the frames it is worth at the speed."""

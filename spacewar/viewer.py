@@ -228,6 +228,15 @@ class Pace:
     def normal(self):
         self.speed = 1.0
 
+    def speed_key(self, name):
+        """Apply a speed key (faster, slower, normal); whether ``name`` was one."""
+        for keys, change in ((K.FASTER, self.faster), (K.SLOWER, self.slower),
+                             (K.NORMAL_SPEED, self.normal)):
+            if name in keys:
+                change()
+                return True
+        return False
+
 
 def check_speed(speed):
     """``speed`` if it is one of ``keys.SPEEDS``, else ValueError naming it."""
@@ -424,12 +433,8 @@ class ReplayView:
             elif name in K.STEP_FORWARD or name in K.STEP_BACK:
                 pace.paused = True
                 self.jump(timeline.frame + (1 if name in K.STEP_FORWARD else -1))
-            elif name in K.FASTER:
-                pace.faster()
-            elif name in K.SLOWER:
-                pace.slower()
-            elif name in K.NORMAL_SPEED:
-                pace.normal()
+            elif pace.speed_key(name):
+                pass
             elif name in K.JUMP_BACK:
                 self.jump(timeline.frame - jump)
             elif name in K.JUMP_FORWARD:
