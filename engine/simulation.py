@@ -246,7 +246,7 @@ class Simulation(DeclaresTerms):
 
     @time.setter
     def time(self, value):
-        self.t = value
+        self._t = finite_float("time", self._code(value, "time", "time"))
 
     @property
     def quantities(self):

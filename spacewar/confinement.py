@@ -39,6 +39,7 @@ UNSHARE_FLAGS = ("--user", "--map-root-user", "--pid", "--fork", "--kill-child",
 _PR_SET_PDEATHSIG, _PR_CAPBSET_DROP = 1, 24
 _MS_NOSUID, _MS_NODEV, _MS_NOEXEC = 2, 4, 8
 _SCRATCH_INODES = 4096  # files and directories a bot's scratch tmpfs may hold
+_PAGE = 4096  # bytes of the smallest piece of a tmpfs a file takes
 
 #: system calls a bot never needs (each fails with EPERM); missing ones on an arch are skipped
 DENIED_SYSCALLS = (
@@ -223,7 +224,9 @@ def _copy_compiled_code(pairs, scratch, budget_bytes, budget_files):
     for source, relative in pairs or ():
         try:
             names = sorted(os.listdir(source), key=lambda n: (n.endswith(".nbi"), n))
-            size = sum(os.path.getsize(os.path.join(source, n)) for n in names)
+            # a tmpfs charges whole pages: count each file's size rounded up to one
+            size = sum(-(-os.path.getsize(os.path.join(source, n)) // _PAGE) * _PAGE
+                       for n in names)
         except OSError:
             continue
         if used_bytes + size > budget_bytes or used_files + len(names) + 1 > budget_files:

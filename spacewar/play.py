@@ -37,7 +37,7 @@ from .match import _result as match_result
 from .protocol import Action, raw_length
 from .render import DIM_TEXT, TEXT, Effects, frame_snapshot, scene
 from .rules import Rules
-from .seats import FAULT_KINDS, bot_name, open_seat
+from .seats import FAULT_KINDS, bot_name, open_seat, printable
 from .viewer import (WATCH_SCREEN_HELP, Pace, Window, blend, check_display, check_speed,
                      check_window_arguments, help_lines, run_window)
 from .viewer import paint as _paint  # noqa: F401  (the name the Gymnasium env's window uses)
@@ -139,8 +139,9 @@ def _open_seats(specs, names, seed, limits, rules, rounds, isolation):
             seat = open_seat(spec, bot_seed(seed, s), limits, rules, isolation, cpu, rounds=rounds)
             seats.append(seat)
             if getattr(seat, "wait_ready", None) is not None and seat.wait_ready() is not None:
+                # the message comes from the bot's process: shown escaped, never as terminal codes
                 raise ValueError(f"bot {names[s]!r} (seat {s + 1}) could not start: "
-                                 f"{seat.dead[1]}")
+                                 f"{printable(str(seat.dead[1]))}")
     except BaseException:
         for seat in seats:
             seat.close()
@@ -494,6 +495,8 @@ def _summary(run, match, result, specs, replay_path, replay_skipped):
     people = [s for s, spec in enumerate(specs) if _is_human(spec)]
     bots = [s for s in range(2) if s not in people]
     winner_seat = result["winner_seat"]
+    if not match.over:
+        winner_seat = None  # left before its end: the score so far names no winner
     if winner_seat is None:
         winner = None
     elif len(people) == 1 and len(bots) == 1:
@@ -544,6 +547,8 @@ def format_summary(summary):
     won = "none (a draw)" if winner is None else f"{names[winner]} (seat {winner + 1})"
     if winner is None and all(summary["forfeits"]):
         won = "none (both forfeited)"
+    elif winner is None and not summary["over"]:
+        won = "none (left before the end)"
     lines.append("")
     lines.append(f"winner: {won}   rounds: {summary['rounds']} of {summary['rounds_asked']}   "
                  f"frames: {summary['frames']}   mode: {summary['mode']}   seed: {summary['seed']}")

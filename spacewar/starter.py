@@ -10,13 +10,14 @@ The file is written atomically and never over an existing one (``write_starter``
 """
 import keyword
 import os
+import shlex
 import secrets
 import sys
 
 from engine.atomic import check_output_path
 
 #: the starter's source; __NAME__, __CLASS__ and __SPEC__ are filled in by ``starter_source``
-TEMPLATE = '''"""__NAME__: a Spacewar! bot, started from ``spacewar new-bot`` (edit it freely).
+TEMPLATE = '''r"""__NAME__: a Spacewar! bot, started from ``spacewar new-bot`` (edit it freely).
 
 Try it:
 
@@ -158,7 +159,13 @@ def starter_source(name, spec=None):
     check_bot_name(name)
     cls = class_name_for(name)
     spec = f"{name}.py:{cls}" if spec is None else spec
-    return TEMPLATE.replace("__NAME__", name).replace("__CLASS__", cls).replace("__SPEC__", spec)
+    # the commands in the docstring, as a shell takes them; the docstring is raw, so a
+    # backslash in a path (C:\\Users) is text, not an escape
+    shown = shlex.quote(spec)
+    if '"""' in shown or not shown.isprintable():
+        raise ValueError(f"the bot's path {spec!r} cannot be written into its docstring: "
+                         "choose a path without newlines, control characters or \"\"\"")
+    return TEMPLATE.replace("__NAME__", name).replace("__CLASS__", cls).replace("__SPEC__", shown)
 
 
 def starter_path(name, out=None):

@@ -7,12 +7,29 @@ import sys
 #: the modules each command needs beyond the core install, and the extra that has them
 NEEDS = {"report": ("rebound", "matplotlib"), "bench": ("rebound",), "advise": ()}
 EXTRA = "validation"
+#: the bench sections that time REBOUND side by side (the others run without it)
+BENCH_REBOUND_SECTIONS = frozenset({"direct", "small", "planets"})
 
 
-def missing_modules(command):
-    """The modules ``command`` needs that cannot be imported here."""
+def _bench_sections(rest):
+    """The sections ``bench``'s ``--only`` names in ``rest`` (None: every section)."""
+    for i, arg in enumerate(rest):
+        if arg == "--only" and i + 1 < len(rest):
+            return set(rest[i + 1].split(","))
+        if arg.startswith("--only="):
+            return set(arg.split("=", 1)[1].split(","))
+    return None
+
+
+def missing_modules(command, rest=()):
+    """The modules ``command`` (with its arguments ``rest``) needs that cannot be imported."""
+    needs = NEEDS[command]
+    if command == "bench":
+        sections = _bench_sections(list(rest))
+        if sections is not None and not sections & BENCH_REBOUND_SECTIONS:
+            needs = ()
     missing = []
-    for name in NEEDS[command]:
+    for name in needs:
         try:
             importlib.import_module(name)
         except ImportError:
@@ -43,7 +60,7 @@ def main(argv=None):
         parser.print_help()
         return 2
     command, rest = argv[0], argv[1:]
-    missing = [] if {"-h", "--help"} & set(rest) else missing_modules(command)
+    missing = [] if {"-h", "--help"} & set(rest) else missing_modules(command, rest)
     if missing:
         print(_missing_message(command, missing), file=sys.stderr)
         return 2

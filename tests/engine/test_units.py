@@ -103,8 +103,11 @@ def test_time_arithmetic_with_quantities_reads_as_written():
     assert later.to_value(u.yr) == pytest.approx(0.5 + 30 / 365.25, rel=1e-12)
     sim.time = 2 * u.d
     assert sim.t == pytest.approx(2 / 365.25, rel=1e-12)
-    with pytest.raises(ValueError, match="time"):
+    with pytest.raises(ValueError, match="^time must be a time"):
         sim.time = 3 * u.kg
+    with pytest.raises(ValueError, match="^time"):
+        sim.time = float("nan")
+    assert sim.t == pytest.approx(2 / 365.25, rel=1e-12)  # refused: nothing changed
 
 
 def test_every_read_out_is_a_quantity_with_the_code_value():

@@ -389,3 +389,23 @@ def test_a_bad_replay_path_is_refused_before_anything_starts(tmp_path, monkeypat
     assert main(["watch", "--replay", str(tmp_path / "keep.gif")]) == 2
     assert "gif" in capsys.readouterr().err.lower() and opened == []
     assert (tmp_path / "keep.gif").read_bytes().startswith(b"GIF89a")
+
+
+def test_a_match_left_before_its_end_names_no_winner():
+    # chaser scores twice against an idle person in the first 1200 frames; quitting there
+    # leaves the match unfinished, and the score so far is no win
+    summary = play(p2="chaser", fps=600, script=[(1200, {"escape"})], max_seconds=60,
+                   scale=256)
+    assert summary["reason"] == "quit" and not summary["over"] and summary["frames"] == 1200
+    assert summary["scores"][1] > summary["scores"][0]
+    assert summary["winner"] is None and summary["winner_seat"] is None
+    assert "winner: none (left before the end)" in format_summary(summary)
+
+
+def test_a_bot_s_start_up_message_is_shown_escaped(tmp_path):
+    path = tmp_path / "loud.py"
+    path.write_text("raise ImportError('\\x1b[31mred\\x1b[0m')\n")
+    with pytest.raises(ValueError, match="could not start") as failed:
+        watch(f"{path}:Bot", "idle", seed=1, rounds=1, fps=240, scale=256, script=[],
+              max_seconds=30)
+    assert "\x1b" not in str(failed.value) and "\\x1b[31mred" in str(failed.value)

@@ -24,3 +24,13 @@ def test_help_needs_no_extra(monkeypatch, capsys):
     with pytest.raises(SystemExit) as exit_:
         main(["bench", "--help"])
     assert exit_.value.code == 0 and "--only" in capsys.readouterr().out
+
+
+def test_bench_sections_without_rebound_need_no_extra(monkeypatch):
+    from validation.__main__ import missing_modules
+
+    monkeypatch.setitem(sys.modules, "rebound", None)
+    assert missing_modules("bench", ["--quick", "--only", "spacewar,batch"]) == []
+    assert missing_modules("bench", ["--only=learning"]) == []
+    assert missing_modules("bench", ["--only", "spacewar,planets"]) == ["rebound"]
+    assert missing_modules("bench", ["--quick"]) == ["rebound"]
