@@ -29,7 +29,7 @@ import json
 import numpy as np
 
 from .bots import BotLoadError, available, locate
-from .match import DEFAULT_MAX_FAULTS, act_time_summary, play_match
+from .match import DEFAULT_MAX_FAULTS, _check_bot_argument, act_time_summary, play_match
 from .rules import Rules, count_at_least
 from .seats import FAULT_KINDS, Limits, bot_name
 
@@ -115,8 +115,9 @@ def check_bot(bot, *, opponents=None, games=1, seed=0, rounds=1, rules=None, lim
     opponents, rules, limits = _checked_arguments(bot, opponents, games, seed, rounds, rules,
                                                   limits, max_faults, isolation)
     report = CheckReport(bot=bot_name(bot), budget=limits.budget, settings={
-        "opponents": list(opponents), "games": games, "seed": seed, "rounds": rounds,
-        "rules": rules.to_dict(), "max_faults": max_faults, "isolation": isolation,
+        "opponents": list(opponents), "games": int(games), "seed": int(seed),
+        "rounds": int(rounds), "rules": rules.to_dict(), "max_faults": int(max_faults),
+        "isolation": isolation,
         "budget": limits.budget, "overage": limits.overage, "startup": limits.startup})
     if isinstance(bot, str):
         try:
@@ -147,18 +148,11 @@ def check_bot(bot, *, opponents=None, games=1, seed=0, rounds=1, rules=None, lim
 def _checked_arguments(bot, opponents, games, seed, rounds, rules, limits, max_faults,
                        isolation):
     """The opponents, rules and limits to play with, after checking every argument."""
-    if not isinstance(bot, str) and not callable(getattr(bot, "act", None)) \
-            and not callable(getattr(bot, "act_batch", None)):
-        raise TypeError(f"bot must be a bot specification (str) or an object with act(obs), "
-                        f"got {type(bot).__name__}")
-    if isinstance(bot, type):
-        raise TypeError(f"bot must be a bot specification or a bot object, got the class "
-                        f"{bot.__qualname__}: pass an instance, {bot.__qualname__}()")
+    _check_bot_argument("bot", bot)
     count_at_least("games", games, 1)
     count_at_least("seed", seed, 0)
     count_at_least("rounds", rounds, 1)
-    if isinstance(max_faults, bool) or not isinstance(max_faults, int) or max_faults < 1:
-        raise ValueError(f"max_faults must be an int >= 1, got {max_faults!r}")
+    count_at_least("max_faults", max_faults, 1)
     if isolation not in ("auto", "process"):
         raise ValueError(f"isolation must be auto or process, got {isolation!r}")
     opponents = available() if opponents is None else opponents

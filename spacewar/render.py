@@ -350,10 +350,14 @@ def footer_top(size, lines):
     return size - lines * footer_pixels(size) * 1.35 - font_pixels(size) * 0.5 * 0.3
 
 
+def _gauge_top(size):
+    """The y pixel where the line under the score (mode and gauges) starts."""
+    return font_pixels(size) * (0.3 + 1.45)
+
+
 def hud_bottom(size):
     """The y pixel below the top lines (score, and the gauges of a ``frame_snapshot``)."""
-    text_px = font_pixels(size)
-    return text_px * 0.3 + text_px * 1.45 + footer_pixels(size) * 1.35 + 6
+    return _gauge_top(size) + footer_pixels(size) * 1.35 + 6
 
 
 def _torpedoes(snapshot, size):
@@ -402,7 +406,7 @@ def _gauges(ship, snapshot, size, seat):
     text_px = font_pixels(size)
     small = footer_pixels(size)
     margin = text_px * 0.5
-    top = margin * 0.6 + text_px * 1.45
+    top = _gauge_top(size)
     fraction = min(1.0, max(0.0, ship["fuel"] / max(snapshot["fuel_capacity"], 1e-300)))
     text = f"fuel {100.0 * fraction:.0f}%  torp {ship['torpedoes']}"
     if size >= 400 and "hyperspace" in ship:
@@ -434,9 +438,7 @@ def _gauges(ship, snapshot, size, seat):
 
 def _hud(snapshot, size):
     """The mode in the middle and each ship's gauges under its name."""
-    text_px = font_pixels(size)
-    top = text_px * 0.3 + text_px * 1.45
-    prims = [("text", size / 2.0, top, snapshot["mode"], DIM_TEXT, "centre", footer_pixels(size))]
+    prims = [("text", size / 2.0, _gauge_top(size), snapshot["mode"], DIM_TEXT, "centre", footer_pixels(size))]
     for seat, ship in enumerate(snapshot["ships"]):
         prims.extend(_gauges(ship, snapshot, size, seat))
     return prims

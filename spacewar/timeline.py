@@ -37,16 +37,11 @@ import numpy as np
 
 from . import replay as replay_io
 from .replay import ReplayError
+from .rules import count_at_least
 
 DEFAULT_CHECKPOINT_EVERY = 64  # frames: about a second of the game at its usual 60 frames a second
 DEFAULT_MAX_CHECKPOINTS = 512  # about 2.5 MB under the 1962 rules
 DEFAULT_SEGMENT_LIMIT = 128
-
-
-def _count(name, value, low):
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < low:
-        raise ValueError(f"{name} must be an int >= {low}, got {value!r}")
-    return int(value)
 
 
 class ReplayTimeline:
@@ -64,9 +59,9 @@ class ReplayTimeline:
 
     def __init__(self, replay, checkpoint_every=DEFAULT_CHECKPOINT_EVERY,
                  max_checkpoints=DEFAULT_MAX_CHECKPOINTS, segment_limit=DEFAULT_SEGMENT_LIMIT):
-        self.interval = _count("checkpoint_every", checkpoint_every, 1)
-        self.max_checkpoints = _count("max_checkpoints", max_checkpoints, 2)
-        self.segment_limit = _count("segment_limit", segment_limit, 0)
+        self.interval = count_at_least("checkpoint_every", checkpoint_every, 1)
+        self.max_checkpoints = count_at_least("max_checkpoints", max_checkpoints, 2)
+        self.segment_limit = count_at_least("segment_limit", segment_limit, 0)
         if isinstance(replay, (str, bytes, os.PathLike)):
             replay = replay_io.load(replay)
         else:
