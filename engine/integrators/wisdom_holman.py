@@ -2,8 +2,10 @@
 
 The Hamiltonian is split as H = H_Kepler + H_interaction, and a step is the symmetric
 composition drift(h/2) kick(h) drift(h/2), where the drift moves every body exactly on its own
-Kepler orbit (``kepler_drift.drift_column``: universal variables, whole periods removed first,
-``engine.analytic.kepler_step`` where its fast iteration does not meet round-off) and the kick adds h times the acceleration of everything the Kepler part leaves out
+Kepler orbit (``kepler_drift.drift_columns``: universal variables, every body's short arc
+solved in lockstep, whole periods removed first from long ones, ``engine.analytic.kepler_step``
+where the fast iteration does not meet round-off) and the kick adds h times the acceleration of
+everything the Kepler part leaves out
 (Wisdom & Holman 1991, AJ 102, 1528; Rein & Tamayo 2015, MNRAS 452, 376). Inside one call the
 half drifts of consecutive steps are merged into one drift, so a step costs one force
 evaluation and one Kepler solve per body (``kepler_drift``); the state is synchronised (the last half drift, the
@@ -50,7 +52,7 @@ from ..forces.gravity import NBodyGravity
 from ..forces.point_mass import PointMass
 from ..space import wrap_scalar
 from .common import OK, all_finite
-from .kepler_drift import drift_column
+from .kepler_drift import SCRATCH_ROWS, drift_columns
 
 NAME = "whfast"
 ORDER = 2
@@ -245,7 +247,7 @@ def _jump(jp, jv, mo, count, massive, m0, h):
     for k in range(dim):
         p = 0.0
         for j in range(1, massive):
-            p += mo[j] * jv[k, j]
+            p += mo[0, j] * jv[k, j]
         shift = h * (p / m0)
         for j in range(1, count):
             jp[k, j] += shift
@@ -271,8 +273,8 @@ def _democratic_interaction(t, jp, jv, state, kick_model, work, m, order, count,
                 dz = jp[2, i] - jp[2, j] if dim == 3 else 0.0
                 r2 = dx * dx + dy * dy + dz * dz
                 f = G / (r2 * math.sqrt(r2))
-                fj = f * mo[i]
-                fi = f * mo[j]
+                fj = f * mo[0, i]
+                fi = f * mo[0, j]
                 ja[0, j] += fj * dx
                 ja[1, j] += fj * dy
                 ja[0, i] -= fi * dx
@@ -286,7 +288,7 @@ def _democratic_interaction(t, jp, jv, state, kick_model, work, m, order, count,
                 dy = jp[1, i] - jp[1, j]
                 dz = jp[2, i] - jp[2, j] if dim == 3 else 0.0
                 r2 = dx * dx + dy * dy + dz * dz
-                f = G * mo[i] / (r2 * math.sqrt(r2))
+                f = G * mo[0, i] / (r2 * math.sqrt(r2))
                 ja[0, j] += f * dx
                 ja[1, j] += f * dy
                 if dim == 3:
@@ -298,7 +300,7 @@ def _democratic_interaction(t, jp, jv, state, kick_model, work, m, order, count,
     for k in range(dim):
         s = 0.0
         for j in range(count):
-            s += mo[j] * acc[k, order[j]]
+            s += mo[0, j] * acc[k, order[j]]
         ja[k, 0] = s / total
     for j in range(1, count):
         i = order[j]
@@ -316,7 +318,7 @@ def _democratic_kick(t, h, jp, jv, state, kick_model, work, m, order, count, eta
     """jump(h/2) interaction(h) jump(h/2); velocity-dependent terms at the midpoint velocity,
     as in the other modes."""
     dim = jp.shape[0]
-    m0 = mo[0]
+    m0 = mo[0, 0]
     _jump(jp, jv, mo, count, massive, m0, 0.5 * h)
     _democratic_interaction(t, jp, jv, state, kick_model, work, m, order, count, eta, mu,
                             center, acc, ja, kick_com, mo, massive, G, vdep)
@@ -334,23 +336,20 @@ def _democratic_kick(t, h, jp, jv, state, kick_model, work, m, order, count, eta
 
 # -- the two operators ------------------------------------------------------------------------
 @njit(cache=True, error_model="numpy", _nrt=False)
-def _kepler_drift(mode, jp, jv, mu, count, h, r, v, box):
-    """Every moving body along its Kepler orbit for time h (mu[j] = 0: a straight line);
-    in JACOBI mode column 0, the centre of mass, always moves in a straight line. In a
-    periodic space (ATTRACTOR mode only) each position relative to the attractor is taken
-    back to its nearest image afterwards, the image the attractor's force acts from."""
+def _kepler_drift(mode, jp, jv, mu, count, h, kw, box):
+    """Every moving body along its Kepler orbit for time h (mu[j] = 0: a straight line;
+    ``kepler_drift.drift_columns``, ``kw`` its scratch); in JACOBI mode column 0, the centre
+    of mass, always moves in a straight line. In a periodic space (ATTRACTOR mode only) each
+    position relative to the attractor is taken back to its nearest image afterwards, the
+    image the attractor's force acts from."""
     dim = jp.shape[0]
     first = 1 if mode != ATTRACTOR else 0
     if mode != ATTRACTOR:
         for k in range(dim):
             jp[k, 0] += h * jv[k, 0]
-    for j in range(first, count):
-        if mu[j] > 0.0:
-            drift_column(jp, jv, j, mu[j], h, r, v)
-        else:
-            for k in range(dim):
-                jp[k, j] += h * jv[k, j]
-        if box > 0.0:
+    drift_columns(jp, jv, first, count, mu, h, kw)
+    if box > 0.0:
+        for j in range(first, count):
             for k in range(dim):
                 jp[k, j] = wrap_scalar(jp[k, j], box)
 
@@ -384,23 +383,24 @@ def _interaction(mode, t, jp, state, kick_model, work, m, order, count, eta, mu,
                 ja[k, j] += s * jp[k, j]
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@njit(cache=True, error_model="numpy", _nrt=False, fastmath={"contract"})
 def _gravity_interaction(jp, mo, count, massive, eta, mu, G, xs, ad, ja):
     """JACOBI_GRAVITY mode's interaction acceleration (``_interaction``'s, for mutual
     gravity alone), on the coordinates' own columns: the inertial positions from the Jacobi
-    ones, every body's pull by the first ``massive`` (the massive bodies; ``mo`` the masses in
-    column order), the Jacobi transform, and the Kepler part's attraction taken out. The pair
-    of the centre and the first body is left out on both sides, and so is that body's Kepler
+    ones, every body's pull by the first ``massive`` (the massive bodies; ``mo[0]`` the
+    masses in column order, ``mo[1]`` the reciprocals of eta), the Jacobi transform, and the
+    Kepler part's attraction taken out. Compiled with contracted multiply-adds: each rounds
+    once, and the chains of the transforms are shorter. The pair of the centre and the first body is left out on both sides, and so is that body's Kepler
     term: they cancel exactly (WH91), and leaving both out keeps the round-off of the largest
     terms out of the interaction (as REBOUND's WHFast does)."""
     dim = jp.shape[0]
     for k in range(dim):
         s = jp[k, 0] * eta[count - 1]
         for j in range(count - 1, 0, -1):
-            s = (s - mo[j] * jp[k, j]) / eta[j]
+            s = (s - mo[0, j] * jp[k, j]) * mo[1, j]
             xs[k, j] = jp[k, j] + s
             s *= eta[j - 1]
-        xs[k, 0] = s / mo[0]
+        xs[k, 0] = s / mo[0, 0]
     for j in range(count):
         for k in range(dim):
             ad[k, j] = 0.0
@@ -413,8 +413,8 @@ def _gravity_interaction(jp, mo, count, massive, eta, mu, G, xs, ad, ja):
             dz = xs[2, i] - xs[2, j] if dim == 3 else 0.0
             r2 = dx * dx + dy * dy + dz * dz
             f = G / (r2 * math.sqrt(r2))
-            fj = f * mo[i]
-            fi = f * mo[j]
+            fj = f * mo[0, i]
+            fi = f * mo[0, j]
             ad[0, j] += fj * dx
             ad[1, j] += fj * dy
             ad[0, i] -= fi * dx
@@ -430,16 +430,16 @@ def _gravity_interaction(jp, mo, count, massive, eta, mu, G, xs, ad, ja):
             dy = xs[1, i] - xs[1, j]
             dz = xs[2, i] - xs[2, j] if dim == 3 else 0.0
             r2 = dx * dx + dy * dy + dz * dz
-            f = G * mo[i] / (r2 * math.sqrt(r2))
+            f = G * mo[0, i] / (r2 * math.sqrt(r2))
             ad[0, j] += f * dx
             ad[1, j] += f * dy
             if dim == 3:
                 ad[2, j] += f * dz
     for k in range(dim):
-        s = mo[0] * ad[k, 0]
+        s = mo[0, 0] * ad[k, 0]
         for j in range(1, count):
-            ja[k, j] = ad[k, j] - s / eta[j - 1]
-            s += mo[j] * ad[k, j]
+            ja[k, j] = ad[k, j] - s * mo[1, j - 1]
+            s += mo[0, j] * ad[k, j]
         ja[k, 0] = 0.0  # mutual gravity does not move the centre of mass
     for j in range(2, count):
         r2 = 0.0
@@ -526,7 +526,7 @@ def _kick(mode, t, h, jp, jv, state, kick_model, work, m, order, count, eta, mu,
 
 @njit(cache=True, error_model="numpy", _nrt=False)
 def _corrector(table, sign, h, mode, t, jp, jv, state, kick_model, work, m, order, count, eta,
-               mu, center, acc, ja, kick_com, r, v, shifted, vdep, mo, xs, ad, massive, G):
+               mu, center, acc, ja, kick_com, kw, shifted, vdep, mo, xs, ad, massive, G):
     """The corrector (sign 1) or its inverse (sign -1): Z(a, b) = D(a) K(-b) D(-2a) K(b) D(a)
     for each row (a / h, b / h) of ``table``."""
     if mode == ATTRACTOR and kick_model.kinds.shape[0] == 0:
@@ -534,13 +534,13 @@ def _corrector(table, sign, h, mode, t, jp, jv, state, kick_model, work, m, orde
     for row in range(table.shape[0]):
         a = table[row, 0] * h
         b = sign * table[row, 1] * h
-        _kepler_drift(mode, jp, jv, mu, count, a, r, v, state.box)
+        _kepler_drift(mode, jp, jv, mu, count, a, kw, state.box)
         _kick(mode, t, -b, jp, jv, state, kick_model, work, m, order, count, eta, mu, center,
               acc, ja, kick_com, KERNEL_STANDARD, shifted, vdep, mo, xs, ad, massive, G)
-        _kepler_drift(mode, jp, jv, mu, count, -2.0 * a, r, v, state.box)
+        _kepler_drift(mode, jp, jv, mu, count, -2.0 * a, kw, state.box)
         _kick(mode, t, b, jp, jv, state, kick_model, work, m, order, count, eta, mu, center,
               acc, ja, kick_com, KERNEL_STANDARD, shifted, vdep, mo, xs, ad, massive, G)
-        _kepler_drift(mode, jp, jv, mu, count, a, r, v, state.box)
+        _kepler_drift(mode, jp, jv, mu, count, a, kw, state.box)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -640,23 +640,22 @@ def advance(t, h, steps, state, kick_model, work, vdep, t_end, mode, order, m, G
     eta = np.empty(count)
     mu = np.empty(count)
     acc = np.empty((dim, state.n))
-    r = np.empty(dim)
-    v = np.empty(dim)
-    mo = np.empty(count)  # JACOBI_GRAVITY: masses, positions, accelerations by column
+    kw = np.empty((SCRATCH_ROWS, max(count, dim)))  # the Kepler drift's
+    mo = np.empty((2, count))  # masses and 1 / eta, positions, accelerations by column
     xs = np.empty((dim, count))
     ad = np.empty((dim, count))
     first_p = pos.copy()  # the call's starting state: kept bit for bit if its first step fails
     first_v = vel.copy()
     return _steps(t, h, steps, state, kick_model, work, vdep, mode, order, m, G, mu_attractor,
                   center, attracted, kick_com, kernel, corrector, drifts, kicks, cc, jp, jv,
-                  save_p, save_v, shifted, ja, ja0, eta, mu, acc, r, v, mo, xs, ad, first_p,
+                  save_p, save_v, shifted, ja, ja0, eta, mu, acc, kw, mo, xs, ad, first_p,
                   first_v)
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
 def _steps(t, h, steps, state, kick_model, work, vdep, mode, order, m, G, mu_attractor, center,
            attracted, kick_com, kernel, corrector, drifts, kicks, cc, jp, jv, save_p, save_v,
-           shifted, ja, ja0, eta, mu, acc, r, v, mo, xs, ad, first_p, first_v):
+           shifted, ja, ja0, eta, mu, acc, kw, mo, xs, ad, first_p, first_v):
     """``advance``'s work in the scratch it made, compiled without reference counting (it
     allocates nothing), as are the operators it calls: a call passing a dozen arrays would
     otherwise pay two atomic updates per array, more than a small system's physics. The
@@ -668,24 +667,26 @@ def _steps(t, h, steps, state, kick_model, work, vdep, mode, order, m, G, mu_att
     stages = kicks.shape[0]
     massive = 0
     for j in range(count):
-        mo[j] = m[order[j]] if mode != ATTRACTOR else 0.0
-        if mo[j] > 0.0:
+        mo[0, j] = m[order[j]] if mode != ATTRACTOR else 0.0
+        if mo[0, j] > 0.0:
             massive = j + 1  # the massive bodies come first
     t0 = t
     _coordinates(mode, pos, vel, m, order, count, center, jp, jv, eta, state.box)
     kepler_parameters(mode, m, order, count, eta, G, mu_attractor, attracted, mu)
+    for j in range(count):
+        mo[1, j] = 1.0 / eta[j] if mode != ATTRACTOR else 0.0
     _corrector(corrector, 1.0, h, mode, t, jp, jv, state, kick_model, work, m, order, count,
-               eta, mu, center, acc, ja, kick_com, r, v, shifted, vdep, mo, xs, ad, massive, G)
+               eta, mu, center, acc, ja, kick_com, kw, shifted, vdep, mo, xs, ad, massive, G)
     if cc != 0.0:
         _lazy_corrector(cc, h, mode, t, jp, jv, state, kick_model, work, m, order, count, eta,
                         mu, center, acc, ja, kick_com, shifted, ja0, vdep)
-    _kepler_drift(mode, jp, jv, mu, count, drifts[0] * h, r, v, state.box)
+    _kepler_drift(mode, jp, jv, mu, count, drifts[0] * h, kw, state.box)
     done = 0
     status = OK
+    if not all_finite(jp, jv, count):  # after this, each step's end is checked
+        status = order[_first_bad_column(jp, jv, count)]
+        steps = 0
     for step in range(steps):
-        if not all_finite(jp, jv, count):
-            status = order[_first_bad_column(jp, jv, count)]
-            break
         for j in range(count):
             for k in range(dim):
                 save_p[k, j] = jp[k, j]
@@ -696,19 +697,19 @@ def _steps(t, h, steps, state, kick_model, work, vdep, mode, order, m, G, mu_att
                   order, count, eta, mu, center, acc, ja, kick_com, kernel, shifted, vdep, mo, xs,
                   ad, massive, G)
             if s < stages - 1:
-                _kepler_drift(mode, jp, jv, mu, count, drifts[s + 1] * h, r, v, state.box)
+                _kepler_drift(mode, jp, jv, mu, count, drifts[s + 1] * h, kw, state.box)
                 elapsed += drifts[s + 1]
         last = drifts[stages]
         if step == steps - 1 or cc != 0.0:
-            _kepler_drift(mode, jp, jv, mu, count, last * h, r, v, state.box)
+            _kepler_drift(mode, jp, jv, mu, count, last * h, kw, state.box)
             if cc != 0.0:
                 _lazy_corrector(cc if step == steps - 1 else 2.0 * cc, h, mode, t + h, jp, jv,
                                 state, kick_model, work, m, order, count, eta, mu, center,
                                 acc, ja, kick_com, shifted, ja0, vdep)
                 if step < steps - 1:
-                    _kepler_drift(mode, jp, jv, mu, count, drifts[0] * h, r, v, state.box)
+                    _kepler_drift(mode, jp, jv, mu, count, drifts[0] * h, kw, state.box)
         else:
-            _kepler_drift(mode, jp, jv, mu, count, (last + drifts[0]) * h, r, v, state.box)
+            _kepler_drift(mode, jp, jv, mu, count, (last + drifts[0]) * h, kw, state.box)
         if not all_finite(jp, jv, count):
             status = order[_first_bad_column(jp, jv, count)]
             break
@@ -716,7 +717,7 @@ def _steps(t, h, steps, state, kick_model, work, vdep, mode, order, m, G, mu_att
         done += 1
     if status == OK:
         _corrector(corrector, -1.0, h, mode, t, jp, jv, state, kick_model, work, m, order,
-                   count, eta, mu, center, acc, ja, kick_com, r, v, shifted, vdep, mo, xs,
+                   count, eta, mu, center, acc, ja, kick_com, kw, shifted, vdep, mo, xs,
                    ad, massive, G)
         _sync_positions(mode, jp, jv, m, order, count, eta, center, pos, vel, True, state.box)
         if all_finite(pos, vel, state.n):
@@ -731,12 +732,12 @@ def _steps(t, h, steps, state, kick_model, work, vdep, mode, order, m, G, mu_att
             for k in range(dim):
                 jp[k, j] = save_p[k, j]
                 jv[k, j] = save_v[k, j]
-        _kepler_drift(mode, jp, jv, mu, count, -drifts[0] * h, r, v, state.box)
+        _kepler_drift(mode, jp, jv, mu, count, -drifts[0] * h, kw, state.box)
         if cc != 0.0:
             _lazy_corrector(-cc, h, mode, t, jp, jv, state, kick_model, work, m, order, count,
                             eta, mu, center, acc, ja, kick_com, shifted, ja0, vdep)
         _corrector(corrector, -1.0, h, mode, t, jp, jv, state, kick_model, work, m, order,
-                   count, eta, mu, center, acc, ja, kick_com, r, v, shifted, vdep, mo, xs,
+                   count, eta, mu, center, acc, ja, kick_com, kw, shifted, vdep, mo, xs,
                    ad, massive, G)
         _sync_positions(mode, jp, jv, m, order, count, eta, center, pos, vel, True, state.box)
         if all_finite(pos, vel, state.n):
