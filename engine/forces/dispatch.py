@@ -116,6 +116,11 @@ EMPTY_MODEL = Model(np.zeros(0, dtype=np.int64), np.zeros(0), np.zeros(1, dtype=
                     np.zeros(0, dtype=np.int64), np.zeros(1, dtype=np.int64))
 
 
+#: the kinds and offsets of one-term models, by (kind, parameter count, index count): shared,
+#: as nothing writes a model's kinds or offsets (only ``Batch`` writes its parameters)
+_ONE_TERM = {}
+
+
 def pack(terms, sim):
     """Concatenate the terms' parameters into the ``Model`` the kernels take.
 
@@ -126,6 +131,20 @@ def pack(terms, sim):
         term._check(sim)
     if not terms:
         return EMPTY_MODEL
+    if len(terms) == 1:
+        # the common scene of one term (a simulation's first call packs it): no concatenation
+        params, indices = terms[0]._pack(sim)
+        params = np.array(params, dtype=np.float64, order="C")
+        indices = np.array(indices, dtype=np.int64, order="C")
+        key = (terms[0].KIND, params.shape[0], indices.shape[0])
+        shared = _ONE_TERM.get(key)
+        if shared is None:
+            shared = (np.array((key[0],), dtype=np.int64), np.array((0, key[1]), dtype=np.int64),
+                      np.array((0, key[2]), dtype=np.int64))
+            if len(_ONE_TERM) < 256:
+                _ONE_TERM[key] = shared
+        kinds, param_offsets, index_offsets = shared
+        return Model(kinds, params, param_offsets, indices, index_offsets)
     param_blocks, index_blocks = [], []
     param_ends, index_ends = [0], [0]
     for term in terms:

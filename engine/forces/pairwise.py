@@ -46,6 +46,11 @@ PARALLEL_MIN = 12
 THREADS_MIN = 192
 
 
+#: the workspace of small systems, shared: its arrays are empty, so nothing can write them
+_NO_WORKSPACE = {flag: Workspace(np.empty(0), np.empty(0, dtype=np.int64), flag)
+                 for flag in (False, True)}
+
+
 def workspace(n, threads=True):
     """Scratch for the large-N kernels, made once per ``step(n)`` call (in Python, so compiled
     code never allocates per force evaluation): compacted coordinates, weights and results
@@ -53,7 +58,7 @@ def workspace(n, threads=True):
     smaller workspace use the scalar pair loop instead. ``threads=False`` keeps the kernels on
     the calling thread (a batch, whose systems already spread over the cores)."""
     if n < PARALLEL_MIN:
-        return Workspace(np.empty(0), np.empty(0, dtype=np.int64), bool(threads))
+        return _NO_WORKSPACE[bool(threads)]
     return Workspace(np.empty(8 * n), np.empty(n, dtype=np.int64), bool(threads))
 
 

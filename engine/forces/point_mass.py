@@ -121,7 +121,11 @@ class PointMass(Force):
         check_particles("particles", self.particles, sim)
 
     def _pack(self, sim):
-        return np.concatenate(([self._mu, self.softening ** 2], self._pos)), self.particles.copy()
+        params = np.empty(2 + self._pos.shape[0])
+        params[0] = self._mu
+        params[1] = self.softening ** 2
+        params[2:] = self._pos
+        return params, self.particles.copy()
 
     def __repr__(self):
         return f"PointMass(mu={self._mu!r}, pos={tuple(self._pos)!r}, softening={self.softening!r})"

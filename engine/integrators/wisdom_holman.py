@@ -630,20 +630,16 @@ def advance(t, h, steps, state, kick_model, work, vdep, t_end, mode, order, m, G
     if count == 0 or steps == 0:
         return t, h, 0, OK
     # every scratch array made here, once: the loop below runs without reference counting
-    jp = np.empty((dim, count))
-    jv = np.empty((dim, count))
-    save_p = np.empty((dim, count))
-    save_v = np.empty((dim, count))
-    shifted = np.empty((dim, count))
-    ja = np.empty((dim, count))
-    ja0 = np.empty((dim, count))
-    eta = np.empty(count)
-    mu = np.empty(count)
+    # (the columns' arrays cut from one allocation: a fresh call allocates little)
+    columns = np.empty((9, dim, count))
+    jp, jv, save_p, save_v = columns[0], columns[1], columns[2], columns[3]
+    shifted, ja, ja0 = columns[4], columns[5], columns[6]
+    xs, ad = columns[7], columns[8]  # JACOBI_GRAVITY: inertial positions, accelerations
+    rows = np.empty((4, count))
+    eta, mu = rows[0], rows[1]
+    mo = rows[2:]  # masses and 1 / eta by column
     acc = np.empty((dim, state.n))
     kw = np.empty((SCRATCH_ROWS, max(count, dim)))  # the Kepler drift's
-    mo = np.empty((2, count))  # masses and 1 / eta, positions, accelerations by column
-    xs = np.empty((dim, count))
-    ad = np.empty((dim, count))
     first_p = pos.copy()  # the call's starting state: kept bit for bit if its first step fails
     first_v = vel.copy()
     return _steps(t, h, steps, state, kick_model, work, vdep, mode, order, m, G, mu_attractor,
@@ -834,6 +830,61 @@ DOMINANCE = 10.0
 _NO_MASSES = np.zeros(1)
 
 
+@njit(cache=True)
+def _attractor_columns(active, pinned, indices, n):
+    """ATTRACTOR mode's columns in one compiled pass (a plan is made on a simulation's first
+    call, where a dozen small numpy calls would cost more than the steps): the moving
+    particles (active, not pinned) in index order, and whether the attractor acts on each
+    particle (``indices`` empty: on all)."""
+    order = np.empty(n, dtype=np.int64)
+    count = 0
+    for i in range(n):
+        if active[i] and not pinned[i]:
+            order[count] = i
+            count += 1
+    attracted = np.empty(max(n, 1), dtype=np.bool_)
+    attracted[:] = indices.shape[0] == 0
+    for i in indices:
+        attracted[i] = True
+    return order[:count].copy(), attracted
+
+
+@njit(cache=True)
+def _jacobi_columns(active, pinned, test, mass, n):
+    """JACOBI mode's columns in one compiled pass: ``(order, masses, heaviest, rest, massive,
+    pinned_active)``: the heaviest moving body first (ties: the lowest index), the other
+    massive ones in index order, then the moving massless ones; the masses the coordinates
+    use (test particles 0); the heaviest body's index (-1: none has mass), the other massive
+    bodies' total and the number of massive moving bodies; the first active pinned particle
+    (-1: none)."""
+    masses = np.empty(n)
+    heaviest = -1
+    pinned_active = -1
+    massive = 0
+    total = 0.0
+    for i in range(n):
+        masses[i] = 0.0 if test[i] else mass[i]
+        if active[i] and pinned[i] and pinned_active < 0:
+            pinned_active = i
+        if active[i] and not pinned[i] and masses[i] > 0.0:
+            total += masses[i]
+            massive += 1
+            if heaviest < 0 or masses[i] > masses[heaviest]:
+                heaviest = i
+    order = np.empty(n, dtype=np.int64)
+    count = 0
+    if heaviest >= 0:
+        order[0] = heaviest
+        count = 1
+    for weighs in (True, False):
+        for i in range(n):
+            if active[i] and not pinned[i] and i != heaviest and (masses[i] > 0.0) == weighs:
+                order[count] = i
+                count += 1
+    rest = total - masses[heaviest] if heaviest >= 0 else 0.0
+    return order[:count].copy(), masses, heaviest, rest, massive, pinned_active
+
+
 class Plan:
     """What ``advance`` needs beyond the state: built by ``plan`` from a simulation's terms."""
 
@@ -859,10 +910,6 @@ def plan(terms, state, model, pack_terms, name="whfast", coordinates="jacobi"):
         raise ValueError(f"coordinates must be one of {', '.join(map(repr, COORDINATES))}, "
                          f"got {coordinates!r}")
     n = state.n
-    active = state.active[:n]
-    pinned = state.pinned[:n]
-    test = state.test[:n]
-    moving = np.nonzero(active > pinned)[0]  # active and not pinned
     attractors = [s for s, term in enumerate(terms) if isinstance(term, PointMass)]
     gravities = [s for s, term in enumerate(terms) if isinstance(term, NBodyGravity)]
     dim = state.pos.shape[0]
@@ -878,14 +925,11 @@ def plan(terms, state, model, pack_terms, name="whfast", coordinates="jacobi"):
                              f"softening must be 0, got {eps2 ** 0.5!r}")
         center = model.params[f0 + 2:f0 + 2 + dim].copy()
         i0, i1 = model.index_offsets[s], model.index_offsets[s + 1]
-        if i1 == i0:
-            attracted = np.ones(max(n, 1), dtype=np.bool_)
-        else:
-            attracted = np.zeros(max(n, 1), dtype=np.bool_)
-            attracted[model.indices[i0:i1]] = True
+        order, attracted = _attractor_columns(state.active, state.pinned,
+                                              model.indices[i0:i1], n)
         others = [term for k, term in enumerate(terms) if k != s]
-        return Plan(ATTRACTOR, moving.astype(np.int64), _NO_MASSES, 0.0, mu, center,
-                    attracted, pack_terms(others), True)
+        return Plan(ATTRACTOR, order, _NO_MASSES, 0.0, mu, center, attracted,
+                    pack_terms(others), True)
     if len(gravities) != 1:
         raise ValueError(f"{name} needs a dominant mass to drift about: declare a PointMass "
                          "attractor, or NBodyGravity with one body much heavier than the rest"
@@ -901,28 +945,23 @@ def plan(terms, state, model, pack_terms, name="whfast", coordinates="jacobi"):
         raise ValueError(f"{name} in {coordinates.replace('_', ' ')} coordinates needs open space, "
                          f"got box={state.box!r} "
                          "(a PointMass attractor may sit in a periodic space)")
-    if (active & pinned).any():
-        i = int(np.flatnonzero(active & pinned)[0])
+    order, masses, heaviest, rest, massive, pinned_active = _jacobi_columns(
+        state.active, state.pinned, state.test, state.mass, n)
+    if pinned_active >= 0:
         raise ValueError(f"{name} in {coordinates.replace('_', ' ')} coordinates moves every body: "
-                         f"particle {i} is "
+                         f"particle {pinned_active} is "
                          "pinned (make a fixed central body a PointMass attractor instead)")
-    masses = np.where(test, 0.0, state.mass[:n])
-    weighs = masses[moving] > 0.0
-    massive = moving[weighs]
-    if massive.shape[0] == 0:
+    if heaviest < 0:
         raise ValueError(f"{name} needs a dominant mass to drift about: no active body has mass")
-    heaviest = int(massive[np.argmax(masses[massive])])  # ties: the lowest index
-    rest = float(sum(masses[massive].tolist())) - masses[heaviest]
-    if massive.shape[0] > 2 and masses[heaviest] < DOMINANCE * rest:
+    if massive > 2 and masses[heaviest] < DOMINANCE * rest:
         raise ValueError(f"{name} needs a dominant mass: the heaviest body (particle {heaviest}, "
                          f"mass {float(masses[heaviest])!r}) carries less than {DOMINANCE:g} times "
                          f"the other bodies' {float(rest)!r}; use a method for any scene "
                          "(engine.integrators.GENERAL) instead")
-    order = np.concatenate(([heaviest], massive[massive != heaviest], moving[~weighs]))
     kick_com = any(not isinstance(term, NBodyGravity) for term in terms)
     if coordinates == "democratic_heliocentric":
         mode = DEMOCRATIC
     else:
         mode = JACOBI if kick_com else JACOBI_GRAVITY
-    return Plan(mode, order.astype(np.int64), masses, G, 0.0, np.zeros(dim),
+    return Plan(mode, order, masses, G, 0.0, np.zeros(dim),
                 np.zeros(1, dtype=np.bool_), model, kick_com)

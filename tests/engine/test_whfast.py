@@ -328,3 +328,26 @@ def test_democratic_heliocentric_refuses_what_it_does_not_support():
         sim.step(1)
     with pytest.raises(ValueError, match="coordinates must be one of"):
         Simulation(dim=2, coordinates="heliocentric")
+
+
+def test_the_plan_orders_the_columns():
+    """The Jacobi columns: the heaviest body first, the other massive ones in index order,
+    then the moving massless ones (test particles count as massless); inactive particles are
+    left out. About an attractor: the moving particles in index order, pinned ones left out,
+    and the attractor acting on the particles it lists."""
+    sim = Simulation(dim=2, integrator="whfast")
+    for mass, test in [(1e-3, False), (0.0, False), (1.0, False), (5e-4, True), (2e-3, False),
+                       (3e-3, False)]:
+        sim.add(mass=mass, pos=(1.0 + mass, 0.5), vel=(0.0, 1.0), test=test)
+    sim.deactivate(5)
+    sim.add_force(forces.NBodyGravity())
+    plan = sim.kepler_plan()
+    assert plan.order.tolist() == [2, 0, 4, 1, 3]
+    assert plan.masses[:5].tolist() == [1e-3, 0.0, 1.0, 0.0, 2e-3]
+    sim = Simulation(dim=2, integrator="whfast")
+    for k in range(4):
+        sim.add(mass=1.0, pos=(1.0 + k, 0.0), vel=(0.0, 1.0), pinned=k == 1)
+    sim.add_force(forces.PointMass(mu=1.0, particles=[0, 1, 3]))
+    plan = sim.kepler_plan()
+    assert plan.order.tolist() == [0, 2, 3]
+    assert plan.attracted[:4].tolist() == [True, True, False, True]
