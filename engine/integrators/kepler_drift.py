@@ -45,17 +45,24 @@ _R72, _R90, _R110, _R132, _R156, _R182, _R210 = (1 / 72, 1 / 90, 1 / 110, 1 / 13
 
 
 @njit(cache=True, error_model="numpy", inline="always")
+def _series(z):
+    """c2(z) and c3(z) by their series to z^6, exact to round-off at |z| <= 0.1; the series'
+    ratios as products by reciprocals, so no division in the hot path."""
+    c3 = (1.0 - z * _R20 * (1.0 - z * _R42 * (1.0 - z * _R72 * (1.0 - z * _R110 * (
+        1.0 - z * _R156 * (1.0 - z * _R210)))))) * _R6
+    c2 = (1.0 - z * _R12 * (1.0 - z * _R30 * (1.0 - z * _R56 * (1.0 - z * _R90 * (
+        1.0 - z * _R132 * (1.0 - z * _R182)))))) * 0.5
+    return c2, c3
+
+
+@njit(cache=True, error_model="numpy", inline="always")
 def stumpff(z):
     """c0(z), c1(z), c2(z), c3(z) by the series at small |z| and quadruple-argument steps."""
     quarterings = 0
     while abs(z) > 0.1:
         z *= 0.25
         quarterings += 1
-    # the series' ratios as products by reciprocals: no division in the hot path
-    c3 = (1.0 - z * _R20 * (1.0 - z * _R42 * (1.0 - z * _R72 * (1.0 - z * _R110 * (
-        1.0 - z * _R156 * (1.0 - z * _R210)))))) * _R6
-    c2 = (1.0 - z * _R12 * (1.0 - z * _R30 * (1.0 - z * _R56 * (1.0 - z * _R90 * (
-        1.0 - z * _R132 * (1.0 - z * _R182)))))) * 0.5
+    c2, c3 = _series(z)
     c1 = 1.0 - z * c3
     c0 = 1.0 - z * c2
     for _ in range(quarterings):
@@ -67,10 +74,9 @@ def stumpff(z):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def drift_column(jp, jv, j, mu, dt, r, v):
-    """Column ``j`` of positions ``jp`` and velocities ``jv`` (dim, count) moved along its
-    Kepler orbit about mu for time dt, in place. ``r``, ``v`` are dim-long scratch for the
-    fallback."""
+def _column(jp, jv, j):
+    """Column j's position and velocity as six scalars (z = vz = 0 in two dimensions), and
+    r0 = |r|, v^2 and eta0 = r . v."""
     dim = jp.shape[0]
     x = jp[0, j]
     y = jp[1, j]
@@ -79,8 +85,25 @@ def drift_column(jp, jv, j, mu, dt, r, v):
     vy = jv[1, j]
     vz = jv[2, j] if dim == 3 else 0.0
     r0 = math.sqrt(x * x + y * y + z * z)
-    v2 = vx * vx + vy * vy + vz * vz
-    eta0 = x * vx + y * vy + z * vz
+    return x, y, z, vx, vy, vz, r0, vx * vx + vy * vy + vz * vz, x * vx + y * vy + z * vz
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _third_order_start(dt, inv, eta0, v2, mu):
+    """X = integral of dt / r, from the Taylor series of 1/r to third order in dt (r' = eta0 /
+    r0, r'' = (v0^2 - r'^2) / r0 - mu / r0^2; ``inv`` = 1 / r0)."""
+    rd = eta0 * inv
+    rdd = (v2 - rd * rd) * inv - mu * inv * inv
+    return dt * inv * (1.0 + dt * inv * (-0.5 * rd + dt * (2.0 * rd * rd * inv - rdd) * _R6))
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def drift_column(jp, jv, j, mu, dt, r, v):
+    """Column ``j`` of positions ``jp`` and velocities ``jv`` (dim, count) moved along its
+    Kepler orbit about mu for time dt, in place. ``r``, ``v`` are dim-long scratch for the
+    fallback."""
+    dim = jp.shape[0]
+    x, y, z, vx, vy, vz, r0, v2, eta0 = _column(jp, jv, j)
     beta = 2.0 * mu / r0 - v2
     zeta0 = mu - beta * r0
     if beta > 0.0 and dt * dt * beta * beta * beta > _LONG_ARC * mu * mu:
@@ -91,14 +114,11 @@ def drift_column(jp, jv, j, mu, dt, r, v):
             dt = np.fmod(dt, period)  # exact
         X = dt * beta / mu
     else:
-        # X = integral of dt / r, from the Taylor series of 1/r to third order in dt
-        # (r' = eta0 / r0, r'' = (v0^2 - r'^2) / r0 - mu / r0^2): on a short arc one Halley
-        # correction then reaches round-off; on a long open one, the first-order term alone
+        # on a short arc one Halley correction from the third-order start reaches round-off;
+        # on a long open one, the first-order term alone
         inv = 1.0 / r0
-        rd = eta0 * inv
-        rdd = (v2 - rd * rd) * inv - mu * inv * inv
         if dt * dt * (v2 + mu * inv) * inv * inv < 0.25:
-            X = dt * inv * (1.0 + dt * inv * (-0.5 * rd + dt * (2.0 * rd * rd * inv - rdd) * _R6))
+            X = _third_order_start(dt, inv, eta0, v2, mu)
         else:
             X = dt * inv
     converged = False
@@ -176,21 +196,10 @@ _BATCH_Z = 0.05
 def _start(jp, jv, j, mu, dt, kw):
     """Column j's invariants and the third-order start of X into ``kw``; False if the column
     is off the lockstep path (a long arc or a large |beta X^2|)."""
-    dim = jp.shape[0]
-    x = jp[0, j]
-    y = jp[1, j]
-    z = jp[2, j] if dim == 3 else 0.0
-    vx = jv[0, j]
-    vy = jv[1, j]
-    vz = jv[2, j] if dim == 3 else 0.0
-    r0 = math.sqrt(x * x + y * y + z * z)
-    v2 = vx * vx + vy * vy + vz * vz
-    eta0 = x * vx + y * vy + z * vz
+    _, _, _, _, _, _, r0, v2, eta0 = _column(jp, jv, j)
     inv = 1.0 / r0
     beta = 2.0 * mu * inv - v2
-    rd = eta0 * inv
-    rdd = (v2 - rd * rd) * inv - mu * inv * inv
-    X = dt * inv * (1.0 + dt * inv * (-0.5 * rd + dt * (2.0 * rd * rd * inv - rdd) * _R6))
+    X = _third_order_start(dt, inv, eta0, v2, mu)
     kw[_R0, j] = r0
     kw[_INV, j] = inv
     kw[_ETA0, j] = eta0
@@ -229,10 +238,7 @@ def _halley_all(kw, first, count):
         beta = kw[_BETA, j]
         X = kw[_X, j]
         z = beta * X * X
-        c3 = (1.0 - z * _R20 * (1.0 - z * _R42 * (1.0 - z * _R72 * (1.0 - z * _R110 * (
-            1.0 - z * _R156 * (1.0 - z * _R210)))))) * _R6
-        c2 = (1.0 - z * _R12 * (1.0 - z * _R30 * (1.0 - z * _R56 * (1.0 - z * _R90 * (
-            1.0 - z * _R132 * (1.0 - z * _R182)))))) * 0.5
+        c2, c3 = _series(z)
         G0 = 1.0 - z * c2
         G1 = X * (1.0 - z * c3)
         G2 = X * X * c2
