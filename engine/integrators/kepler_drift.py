@@ -24,9 +24,8 @@ fraction of an orbit from the previous drift's end, which a lighter solver handl
 If the iteration has not met round-off after ``MAX_ITERATIONS``, the drift is taken by
 ``engine.analytic.kepler_step`` instead, so the fast path never returns a worse answer.
 
-``drift_columns`` moves all of a step's bodies at once: the common short arc of each in
-lockstep (one Halley correction from the third-order start, see there), the rest by
-``drift_column``.
+``drift_columns`` moves all of a step's bodies at once, their iterations in lockstep (see
+there).
 """
 import math
 
@@ -177,29 +176,35 @@ def drift_column(jp, jv, j, mu, dt, r, v):
 # One drift is a chain of dependent operations (a square root, a reciprocal, the start of X, two
 # polynomials, Halley's correction, the Lagrange coefficients): about 100 ns of latency for a few
 # dozen floating-point operations. The columns of a step are independent, so ``drift_columns``
-# takes them in lockstep, one stage of the solve at a time over all columns, in loops without
-# branches that the processor overlaps: the cost per column comes near the operations'
-# throughput, not their latency (the 5 drifts of an outer-solar-system step: 0.51-0.76 us one at
-# a time, 0.30-0.41 us in lockstep, measured side by side). Multiply-adds are contracted: each
-# rounds once and shortens the chains. Columns off that common path (long arcs, large
-# |beta X^2|, no convergence after one correction) are left to ``drift_column``.
+# takes them in lockstep, one stage of the solve at a time over all columns (each Halley
+# iteration over the columns still pending), so that the processor overlaps them: the cost per
+# column comes near the operations' throughput, not their latency (the 5 drifts of an
+# outer-solar-system step: 0.51-0.76 us one at a time, 0.30-0.41 us in lockstep, measured side
+# by side). Each column starts and iterates as in ``drift_column``; multiply-adds are
+# contracted (each rounds once, and the chains are shorter). A column whose iteration fails is
+# left to ``drift_column`` and its reference-solver fallback.
 
 #: rows of ``drift_columns``' scratch (``SCRATCH_ROWS`` by max(count, 3))
 _RV_R, _RV_V, _R0, _ETA0, _MU, _BETA, _ZETA0, _X, _DT, _G1, _G2, _RN, _OK, _INV = range(14)
 SCRATCH_ROWS = 14
-#: |beta X^2| of the start above which a column is left to ``drift_column``: the Stumpff series
-#: alone (no quarterings) is then exact to round-off, with a margin for Halley's correction
-_BATCH_Z = 0.05
 
 
 @njit(cache=True, error_model="numpy", inline="always")
 def _start(jp, jv, j, mu, dt, kw):
-    """Column j's invariants and the third-order start of X into ``kw``; False if the column
-    is off the lockstep path (a long arc or a large |beta X^2|)."""
+    """Column j's invariants and the start of X into ``kw``, chosen as ``drift_column``
+    chooses it (whole periods of a long elliptic arc dropped into ``kw[_DT]``)."""
     _, _, _, _, _, _, r0, v2, eta0 = _column(jp, jv, j)
     inv = 1.0 / r0
     beta = 2.0 * mu * inv - v2
-    X = _third_order_start(dt, inv, eta0, v2, mu)
+    if beta > 0.0 and dt * dt * beta * beta * beta > _LONG_ARC * mu * mu:
+        period = _TWO_PI * mu / (beta * math.sqrt(beta))
+        if abs(dt) > period:
+            dt = np.fmod(dt, period)
+        X = dt * beta / mu
+    elif dt * dt * (v2 + mu * inv) * inv * inv < 0.25:
+        X = _third_order_start(dt, inv, eta0, v2, mu)
+    else:
+        X = dt * inv
     kw[_R0, j] = r0
     kw[_INV, j] = inv
     kw[_ETA0, j] = eta0
@@ -208,8 +213,6 @@ def _start(jp, jv, j, mu, dt, kw):
     kw[_ZETA0, j] = mu - beta * r0
     kw[_X, j] = X
     kw[_DT, j] = dt
-    return (dt * dt * (v2 + mu * inv) * inv * inv < 0.25 and abs(beta * X * X) <= _BATCH_Z
-            and not (beta > 0.0 and dt * dt * beta * beta * beta > _LONG_ARC * mu * mu))
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -228,40 +231,56 @@ def _neutral(kw, j):
 
 @njit(cache=True, error_model="numpy", inline="always")
 def _halley_all(kw, first, count):
-    """One Halley correction of X for every column, in lockstep, and the G's moved to the
-    corrected X by their Taylor series (as in ``drift_column``); ``kw[_OK]`` keeps 1 where the
-    correction was at most 1e-7 of X (X then exact to round-off) and r stays positive."""
+    """Halley's iteration for X of every pending column (``kw[_OK]`` 1), the columns in
+    lockstep, as ``drift_column`` iterates: a column whose correction was at most 1e-7 of X
+    (X then exact to round-off) gets its G's moved to the corrected X by their Taylor series
+    and ``kw[_OK]`` 2 (0 if r is not positive there); columns still pending after
+    ``MAX_ITERATIONS``, or whose X is not finite, get 0."""
+    for _ in range(MAX_ITERATIONS):
+        pending = 0
+        for j in range(first, count):
+            if kw[_OK, j] != 1.0:
+                continue
+            r0 = kw[_R0, j]
+            eta0 = kw[_ETA0, j]
+            mu = kw[_MU, j]
+            beta = kw[_BETA, j]
+            X = kw[_X, j]
+            c0, c1, c2, c3 = stumpff(beta * X * X)
+            G0 = c0
+            G1 = X * c1
+            G2 = X * X * c2
+            G3 = X * X * X * c3
+            rn = r0 * G0 + eta0 * G1 + mu * G2
+            F = r0 * G1 + eta0 * G2 + mu * G3 - kw[_DT, j]
+            F2 = eta0 * G0 + kw[_ZETA0, j] * G1
+            step = F * rn / (rn * rn - 0.5 * F * F2)
+            X -= step
+            if abs(step) <= 1e-7 * abs(X) or F == 0.0:
+                half = 0.5 * step * step
+                G1n = G1 - step * G0 - half * beta * G1
+                G2n = G2 - step * G1 + half * G0
+                G0n = G0 + step * beta * G1 - half * beta * G0
+                rn = r0 * G0n + eta0 * G1n + mu * G2n
+                kw[_G1, j] = G1n
+                kw[_G2, j] = G2n
+                kw[_RN, j] = rn
+                kw[_OK, j] = 2.0 if rn > 0.0 else 0.0
+            elif math.isfinite(X):
+                kw[_X, j] = X
+                pending += 1
+            else:
+                kw[_OK, j] = 0.0
+        if pending == 0:
+            return
     for j in range(first, count):
-        r0 = kw[_R0, j]
-        eta0 = kw[_ETA0, j]
-        mu = kw[_MU, j]
-        beta = kw[_BETA, j]
-        X = kw[_X, j]
-        z = beta * X * X
-        c2, c3 = _series(z)
-        G0 = 1.0 - z * c2
-        G1 = X * (1.0 - z * c3)
-        G2 = X * X * c2
-        G3 = X * X * X * c3
-        rn = r0 * G0 + eta0 * G1 + mu * G2
-        F = r0 * G1 + eta0 * G2 + mu * G3 - kw[_DT, j]
-        F2 = eta0 * G0 + kw[_ZETA0, j] * G1
-        step = F * rn / (rn * rn - 0.5 * F * F2)
-        half = 0.5 * step * step
-        G0n = G0 + step * beta * G1 - half * beta * G0
-        G1n = G1 - step * G0 - half * beta * G1
-        G2n = G2 - step * G1 + half * G0
-        rn = r0 * G0n + eta0 * G1n + mu * G2n
-        kw[_G1, j] = G1n
-        kw[_G2, j] = G2n
-        kw[_RN, j] = rn
-        ok = abs(step) <= 1e-7 * abs(X) and rn > 0.0
-        kw[_OK, j] = kw[_OK, j] if ok else 0.0
+        if kw[_OK, j] == 1.0:
+            kw[_OK, j] = 0.0
 
 
 @njit(cache=True, error_model="numpy", inline="always")
 def _apply_all(jp, jv, kw, first, count):
-    """x' = f x + g v, v' = fd x + gd v for every column marked in ``kw[_OK]``, from the
+    """x' = f x + g v, v' = fd x + gd v for every column solved (``kw[_OK]`` 2), from the
     Lagrange coefficients f = 1 - mu G2 / r0, g = r0 G1 + eta0 G2, fd = -mu G1 / (r0 r),
     gd = 1 - mu G2 / r."""
     dim = jp.shape[0]
@@ -271,7 +290,7 @@ def _apply_all(jp, jv, kw, first, count):
         G1 = kw[_G1, j]
         G2 = kw[_G2, j]
         rn = kw[_RN, j]
-        ok = kw[_OK, j] != 0.0
+        ok = kw[_OK, j] == 2.0
         inv_r0 = kw[_INV, j]
         inv_rn = 1.0 / rn
         f = 1.0 - mu * G2 * inv_r0
@@ -296,25 +315,23 @@ def _drift_column_call(jp, jv, j, mu, dt, kw):
 def drift_columns(jp, jv, first, count, mu, dt, kw):
     """Columns ``first`` to ``count`` of ``jp``, ``jv`` (dim, count) moved along their Kepler
     orbits about ``mu[j]`` for time dt, in place (mu[j] = 0: a straight line): the same
-    result as ``drift_column`` on each, to round-off, with the columns of the common short
-    arc solved in lockstep (see above). ``kw`` is scratch of ``SCRATCH_ROWS`` rows and at
+    result as ``drift_column`` on each, to round-off, the columns solved in lockstep (see
+    above). ``kw`` is scratch of ``SCRATCH_ROWS`` rows and at
     least max(count, 3) columns."""
     dim = jp.shape[0]
-    batched = 0
+    kepler = 0
     for j in range(first, count):
-        if mu[j] > 0.0 and _start(jp, jv, j, mu[j], dt, kw):
+        if mu[j] > 0.0:
+            _start(jp, jv, j, mu[j], dt, kw)
             kw[_OK, j] = 1.0
-            batched += 1
+            kepler += 1
         else:
             _neutral(kw, j)
-            if mu[j] > 0.0:
-                kw[_OK, j] = -1.0  # for drift_column, below
-            else:
-                for k in range(dim):
-                    jp[k, j] += dt * jv[k, j]
-    if batched > 0:
+            for k in range(dim):
+                jp[k, j] += dt * jv[k, j]
+    if kepler > 0:
         _halley_all(kw, first, count)
         _apply_all(jp, jv, kw, first, count)
-    for j in range(first, count):
-        if mu[j] > 0.0 and kw[_OK, j] != 1.0:
-            _drift_column_call(jp, jv, j, mu[j], dt, kw)
+        for j in range(first, count):
+            if mu[j] > 0.0 and kw[_OK, j] != 2.0:
+                _drift_column_call(jp, jv, j, mu[j], dt, kw)
