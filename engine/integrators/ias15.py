@@ -139,8 +139,10 @@ def _as_array(rows):
 _S, _DIFF, _POWER, _INVERSE = _exact_tables()
 #: the eight nodes 0, h1, ..., h7
 _H = np.array([float(v) for v in _S])
-#: _R[n, j] = h_n - h_j (j < n): the divisors of the divided differences at node n
-_R = _as_array(_DIFF)
+#: _RINV[n, j] = 1 / (h_n - h_j) (j < n), exact and rounded once: the divided differences at
+#: node n multiply by these (a division costs several multiplications, and an iteration takes
+#: 28 per coordinate)
+_RINV = _as_array([[1 / v if v else 0 for v in row] for row in _DIFF])
 #: b_j = sum_k _C[k, j] g_k  (Everhart's c table, with the unit diagonal)
 _C = _as_array(_POWER)
 #: g_k = sum_j _D[j, k] b_j  (Everhart's d table, with the unit diagonal); _D = _C^-1
@@ -411,7 +413,7 @@ def _iterate(t, dt, state, model, work, vdep, mask, a0, v0, b, csx, csv, g, csb,
             _forces(t + sdt, sub, model, acc, work, fused)
             evaluations += 1
             last = node - 1  # the coefficient g_last this node determines
-            r0 = _R[node, 0]
+            r0 = _RINV[node, 0]
             finite = 0.0
             max_a = 0.0
             max_db = 0.0
@@ -421,9 +423,9 @@ def _iterate(t, dt, state, model, work, vdep, mask, a0, v0, b, csx, csv, g, csb,
                 for i in range(n):
                     a = acc[k, i] if mask[i] != 0.0 else 0.0
                     finite += a * 0.0
-                    x = (a - a0[k, i]) / r0
+                    x = (a - a0[k, i]) * r0
                     for j in range(1, node):
-                        x = (x - g[j - 1, k, i]) / _R[node, j]
+                        x = (x - g[j - 1, k, i]) * _RINV[node, j]
                     change = x - g[last, k, i]
                     g[last, k, i] = x
                     for j in range(last + 1):

@@ -70,6 +70,9 @@ def test_gauss_radau_constants():
     residual = leg.legval(x, [0] * 7 + [1]) + leg.legval(x, [0] * 8 + [1])
     assert np.abs(residual).max() < 1e-14
     assert ias15._H[0] == 0.0 and np.all(np.diff(ias15._H) > 0.0)
+    for n in range(1, 8):
+        for j in range(n):
+            assert ias15._RINV[n, j] * (ias15._H[n] - ias15._H[j]) == pytest.approx(1.0, rel=3e-16)
     assert np.abs(ias15._C @ ias15._D - np.eye(7)).max() < 1e-15
     # Everhart's c and d tables, spot values (as tabulated by Rein & Spiegel 2015)
     assert ias15._C[1, 0] == -ias15._H[1] and ias15._D[1, 0] == ias15._H[1]
@@ -229,8 +232,11 @@ def _two_body_energy(m1, m2, x1, x2, v1, v2):
 def test_pythagorean_problem_m3_escapes():
     """Burrau's problem to t = 70 (Szebehely & Peters 1967): after the close encounters the
     lightest body (m = 3) leaves on an unbound orbit and m = 4, 5 remain a bound binary.
-    Measured: relative energy error 2.3e-11 in 5378 steps; REBOUND's IAS15 on the same problem
-    ends with the same break-up (positions agree to 5e-3 after the chaotic encounters)."""
+    Measured: relative energy error 1.0e-10 in 5377 steps (REBOUND's IAS15: 3.1e-11 in 5380).
+    The encounters amplify round-off, so the error is a draw from a spread: twelve starts moved
+    by up to 1.1e-12 gave 1e-12 to 2.1e-10, median 3.8e-11, both with this code and with
+    divided differences that divide instead of multiplying by reciprocals. REBOUND's IAS15 ends
+    with the same break-up (positions agree to 5e-3 after the chaotic encounters)."""
     p = problems.pythagorean()
     sim = problems.make_sim(p, "rk45", 0.01)
     state, model, work, memory = kernel(sim)
@@ -239,7 +245,7 @@ def test_pythagorean_problem_m3_escapes():
     t, h, done, status = ias15.advance(0.0, 0.01, 10 ** 7, state, model, work, False, 70.0,
                                        1e-9, memory)
     assert (t, status) == (70.0, OK)
-    assert abs(sim.energy() - e0) / abs(e0) < 1e-10
+    assert abs(sim.energy() - e0) / abs(e0) < 3e-10
     m = sim.mass
     x = sim.pos.copy()
     v = sim.vel.copy()
