@@ -2,14 +2,14 @@
 
 The Hamiltonian is split as H = H_Kepler + H_interaction, and a step is the symmetric
 composition drift(h/2) kick(h) drift(h/2), where the drift moves every body exactly on its own
-Kepler orbit (``kepler_drift.drift_columns``: universal variables, every body's short arc
-solved in lockstep, whole periods removed first from long ones, ``engine.analytic.kepler_step``
+Kepler orbit (``kepler_drift.drift_columns``: universal variables, every body of the step
+solved in lockstep, whole periods removed first from long arcs, ``engine.analytic.kepler_step``
 where the fast iteration does not meet round-off) and the kick adds h times the acceleration of
 everything the Kepler part leaves out
 (Wisdom & Holman 1991, AJ 102, 1528; Rein & Tamayo 2015, MNRAS 452, 376). Inside one call the
 half drifts of consecutive steps are merged into one drift, so a step costs one force
-evaluation and one Kepler solve per body (``kepler_drift``); the state is synchronised (the last half drift, the
-corrector's inverse, inertial coordinates) when the call ends.
+evaluation and one Kepler solve per body (``kepler_drift``); the state is synchronised (the
+last half drift, the corrector's inverse, inertial coordinates) when the call ends.
 
 Two kinds of scene:
 
@@ -390,9 +390,10 @@ def _gravity_interaction(jp, mo, count, massive, eta, mu, G, xs, ad, ja):
     ones, every body's pull by the first ``massive`` (the massive bodies; ``mo[0]`` the
     masses in column order, ``mo[1]`` the reciprocals of eta), the Jacobi transform, and the
     Kepler part's attraction taken out. Compiled with contracted multiply-adds: each rounds
-    once, and the chains of the transforms are shorter. The pair of the centre and the first body is left out on both sides, and so is that body's Kepler
-    term: they cancel exactly (WH91), and leaving both out keeps the round-off of the largest
-    terms out of the interaction (as REBOUND's WHFast does)."""
+    once, and the chains of the transforms are shorter. The pair of the centre and the first
+    body is left out on both sides, and so is that body's Kepler term: they cancel exactly
+    (WH91), and leaving both out keeps the round-off of the largest terms out of the
+    interaction (as REBOUND's WHFast does)."""
     dim = jp.shape[0]
     for k in range(dim):
         s = jp[k, 0] * eta[count - 1]
@@ -902,9 +903,10 @@ def plan(terms, state, model, pack_terms, name="whfast", coordinates="jacobi"):
     """The Wisdom-Holman plan for a scene, or ValueError naming why it has none.
 
     ``terms`` are the declared force terms (in model order), ``pack_terms(list)`` packs a
-    subset into a ``Model``; ``name`` is the integrator the messages name. A single ``PointMass`` (without softening) makes ATTRACTOR mode;
-    otherwise a single ``NBodyGravity`` (without softening, in open space) whose heaviest body
-    dominates (``DOMINANCE``) makes JACOBI mode, or DEMOCRATIC mode with ``coordinates``
+    subset into a ``Model``; ``name`` is the integrator the messages name. A single
+    ``PointMass`` (without softening) makes ATTRACTOR mode; otherwise a single
+    ``NBodyGravity`` (without softening, in open space) whose heaviest body dominates
+    (``DOMINANCE``) makes JACOBI mode, or DEMOCRATIC mode with ``coordinates``
     ``"democratic_heliocentric"``."""
     if coordinates not in COORDINATES:
         raise ValueError(f"coordinates must be one of {', '.join(map(repr, COORDINATES))}, "
