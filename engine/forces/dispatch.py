@@ -13,6 +13,8 @@ for a five-body system that was seven times the cost of the physics itself (140 
 20 ns per evaluation, measured). The named tuples of ``engine.state`` are passed as plain
 structs, so reading their fields costs nothing.
 """
+import functools
+
 import numpy as np
 from numba import njit
 
@@ -116,9 +118,12 @@ EMPTY_MODEL = Model(np.zeros(0, dtype=np.int64), np.zeros(0), np.zeros(1, dtype=
                     np.zeros(0, dtype=np.int64), np.zeros(1, dtype=np.int64))
 
 
-#: the kinds and offsets of one-term models, by (kind, parameter count, index count): shared,
-#: as nothing writes a model's kinds or offsets (only ``Batch`` writes its parameters)
-_ONE_TERM = {}
+@functools.lru_cache(maxsize=256)
+def _layout(kinds, param_ends, index_ends):
+    """A model's kinds and offsets arrays for these tuples, made once and shared: nothing
+    writes a model's kinds or offsets (only ``Batch`` writes its parameters)."""
+    return (np.array(kinds, dtype=np.int64), np.array(param_ends, dtype=np.int64),
+            np.array(index_ends, dtype=np.int64))
 
 
 def pack(terms, sim):
@@ -131,20 +136,6 @@ def pack(terms, sim):
         term._check(sim)
     if not terms:
         return EMPTY_MODEL
-    if len(terms) == 1:
-        # the common scene of one term (a simulation's first call packs it): no concatenation
-        params, indices = terms[0]._pack(sim)
-        params = np.array(params, dtype=np.float64, order="C")
-        indices = np.array(indices, dtype=np.int64, order="C")
-        key = (terms[0].KIND, params.shape[0], indices.shape[0])
-        shared = _ONE_TERM.get(key)
-        if shared is None:
-            shared = (np.array((key[0],), dtype=np.int64), np.array((0, key[1]), dtype=np.int64),
-                      np.array((0, key[2]), dtype=np.int64))
-            if len(_ONE_TERM) < 256:
-                _ONE_TERM[key] = shared
-        kinds, param_offsets, index_offsets = shared
-        return Model(kinds, params, param_offsets, indices, index_offsets)
     param_blocks, index_blocks = [], []
     param_ends, index_ends = [0], [0]
     for term in terms:
@@ -157,9 +148,11 @@ def pack(terms, sim):
         # and for a few terms numpy's per-call cost would be most of the work
         param_ends.append(param_ends[-1] + params.shape[0])
         index_ends.append(index_ends[-1] + indices.shape[0])
-    kinds = np.array([term.KIND for term in terms], dtype=np.int64)
-    param_offsets = np.array(param_ends, dtype=np.int64)
-    index_offsets = np.array(index_ends, dtype=np.int64)
-    params = np.concatenate(param_blocks)
-    indices = np.concatenate(index_blocks)
+    kinds, param_offsets, index_offsets = _layout(tuple(term.KIND for term in terms),
+                                                  tuple(param_ends), tuple(index_ends))
+    if len(terms) == 1:  # the common scene: its own arrays, copied (a term's may be shared)
+        params, indices = param_blocks[0].copy(), index_blocks[0].copy()
+    else:
+        params = np.concatenate(param_blocks)
+        indices = np.concatenate(index_blocks)
     return Model(kinds, params, param_offsets, indices, index_offsets)

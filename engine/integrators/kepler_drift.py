@@ -44,24 +44,17 @@ _R72, _R90, _R110, _R132, _R156, _R182, _R210 = (1 / 72, 1 / 90, 1 / 110, 1 / 13
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _series(z):
-    """c2(z) and c3(z) by their series to z^6, exact to round-off at |z| <= 0.1; the series'
-    ratios as products by reciprocals, so no division in the hot path."""
-    c3 = (1.0 - z * _R20 * (1.0 - z * _R42 * (1.0 - z * _R72 * (1.0 - z * _R110 * (
-        1.0 - z * _R156 * (1.0 - z * _R210)))))) * _R6
-    c2 = (1.0 - z * _R12 * (1.0 - z * _R30 * (1.0 - z * _R56 * (1.0 - z * _R90 * (
-        1.0 - z * _R132 * (1.0 - z * _R182)))))) * 0.5
-    return c2, c3
-
-
-@njit(cache=True, error_model="numpy", inline="always")
 def stumpff(z):
     """c0(z), c1(z), c2(z), c3(z) by the series at small |z| and quadruple-argument steps."""
     quarterings = 0
     while abs(z) > 0.1:
         z *= 0.25
         quarterings += 1
-    c2, c3 = _series(z)
+    # the series' ratios as products by reciprocals: no division in the hot path
+    c3 = (1.0 - z * _R20 * (1.0 - z * _R42 * (1.0 - z * _R72 * (1.0 - z * _R110 * (
+        1.0 - z * _R156 * (1.0 - z * _R210)))))) * _R6
+    c2 = (1.0 - z * _R12 * (1.0 - z * _R30 * (1.0 - z * _R56 * (1.0 - z * _R90 * (
+        1.0 - z * _R132 * (1.0 - z * _R182)))))) * 0.5
     c1 = 1.0 - z * c3
     c0 = 1.0 - z * c2
     for _ in range(quarterings):
@@ -97,6 +90,24 @@ def _third_order_start(dt, inv, eta0, v2, mu):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
+def _start_of_x(dt, r0, eta0, v2, beta, mu):
+    """``(X, dt)``: where Halley's iteration for X starts, and the time it solves for."""
+    if beta > 0.0 and dt * dt * beta * beta * beta > _LONG_ARC * mu * mu:
+        # an elliptic arc of more than a twentieth of the period: its whole periods dropped,
+        # then the mean of dX/dt = 1/r over an orbit
+        period = _TWO_PI * mu / (beta * math.sqrt(beta))
+        if abs(dt) > period:
+            dt = np.fmod(dt, period)  # exact
+        return dt * beta / mu, dt
+    # on a short arc one Halley correction from the third-order start reaches round-off; on
+    # a long open one, the first-order term alone
+    inv = 1.0 / r0
+    if dt * dt * (v2 + mu * inv) * inv * inv < 0.25:
+        return _third_order_start(dt, inv, eta0, v2, mu), dt
+    return dt * inv, dt
+
+
+@njit(cache=True, error_model="numpy", inline="always")
 def drift_column(jp, jv, j, mu, dt, r, v):
     """Column ``j`` of positions ``jp`` and velocities ``jv`` (dim, count) moved along its
     Kepler orbit about mu for time dt, in place. ``r``, ``v`` are dim-long scratch for the
@@ -105,21 +116,7 @@ def drift_column(jp, jv, j, mu, dt, r, v):
     x, y, z, vx, vy, vz, r0, v2, eta0 = _column(jp, jv, j)
     beta = 2.0 * mu / r0 - v2
     zeta0 = mu - beta * r0
-    if beta > 0.0 and dt * dt * beta * beta * beta > _LONG_ARC * mu * mu:
-        # an elliptic arc of more than a twentieth of the period: its whole periods dropped,
-        # then the mean of dX/dt = 1/r over an orbit
-        period = _TWO_PI * mu / (beta * math.sqrt(beta))
-        if abs(dt) > period:
-            dt = np.fmod(dt, period)  # exact
-        X = dt * beta / mu
-    else:
-        # on a short arc one Halley correction from the third-order start reaches round-off;
-        # on a long open one, the first-order term alone
-        inv = 1.0 / r0
-        if dt * dt * (v2 + mu * inv) * inv * inv < 0.25:
-            X = _third_order_start(dt, inv, eta0, v2, mu)
-        else:
-            X = dt * inv
+    X, dt = _start_of_x(dt, r0, eta0, v2, beta, mu)
     converged = False
     G0 = G1 = G2 = G3 = rn = 0.0
     for _ in range(MAX_ITERATIONS):
@@ -191,20 +188,12 @@ SCRATCH_ROWS = 14
 
 @njit(cache=True, error_model="numpy", inline="always")
 def _start(jp, jv, j, mu, dt, kw):
-    """Column j's invariants and the start of X into ``kw``, chosen as ``drift_column``
-    chooses it (whole periods of a long elliptic arc dropped into ``kw[_DT]``)."""
+    """Column j's invariants and the start of X into ``kw``, as ``drift_column`` starts
+    (``_start_of_x``; whole periods of a long elliptic arc dropped from ``kw[_DT]``)."""
     _, _, _, _, _, _, r0, v2, eta0 = _column(jp, jv, j)
     inv = 1.0 / r0
     beta = 2.0 * mu * inv - v2
-    if beta > 0.0 and dt * dt * beta * beta * beta > _LONG_ARC * mu * mu:
-        period = _TWO_PI * mu / (beta * math.sqrt(beta))
-        if abs(dt) > period:
-            dt = np.fmod(dt, period)
-        X = dt * beta / mu
-    elif dt * dt * (v2 + mu * inv) * inv * inv < 0.25:
-        X = _third_order_start(dt, inv, eta0, v2, mu)
-    else:
-        X = dt * inv
+    X, dt = _start_of_x(dt, r0, eta0, v2, beta, mu)
     kw[_R0, j] = r0
     kw[_INV, j] = inv
     kw[_ETA0, j] = eta0
@@ -213,20 +202,6 @@ def _start(jp, jv, j, mu, dt, kw):
     kw[_ZETA0, j] = mu - beta * r0
     kw[_X, j] = X
     kw[_DT, j] = dt
-
-
-@njit(cache=True, error_model="numpy", inline="always")
-def _neutral(kw, j):
-    """A benign column for the lockstep loops (its results are not used)."""
-    kw[_R0, j] = 1.0
-    kw[_INV, j] = 1.0
-    kw[_ETA0, j] = 0.0
-    kw[_MU, j] = 1.0
-    kw[_BETA, j] = 1.0
-    kw[_ZETA0, j] = 0.0
-    kw[_X, j] = 0.0
-    kw[_DT, j] = 0.0
-    kw[_OK, j] = 0.0
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -325,8 +300,8 @@ def drift_columns(jp, jv, first, count, mu, dt, kw):
             _start(jp, jv, j, mu[j], dt, kw)
             kw[_OK, j] = 1.0
             kepler += 1
-        else:
-            _neutral(kw, j)
+        else:  # a straight line; the lockstep loops skip it (its rows are not read for it)
+            kw[_OK, j] = 0.0
             for k in range(dim):
                 jp[k, j] += dt * jv[k, j]
     if kepler > 0:
