@@ -89,7 +89,8 @@ def test_gauss_radau_constants():
 def test_fixed_step_matches_rebound_step_for_step():
     """Outer solar system, epsilon 0 in both (fixed 50-day steps), 1000 steps (11.5 Jupiter
     orbits). Largest difference measured, per body over its largest coordinate: positions
-    2.6e-14 (Jupiter), velocities 2.1e-14. The same kernel without compensated summation of
+    3.7e-14 (Jupiter), velocities 3.1e-14 (2.6e-14 and 2.1e-14 before the kernel's
+    multiply-adds were contracted). The same kernel without compensated summation of
     positions and velocities measured 3.9e-13, hence the bound of 1e-13."""
     sim = solar()
     state, model, work, memory = kernel(sim)
@@ -113,12 +114,13 @@ def test_fixed_step_matches_rebound_step_for_step():
 
 def test_adaptive_steps_match_rebound():
     """epsilon = 1e-9 (the default) from a 50-day first step: the step sizes of the first 100
-    steps agree with REBOUND's to 2.4e-11 (measured); that is their sensitivity to round-off,
+    steps agree with REBOUND's to 1.9e-11 (measured; 2.4e-11 before the kernel's multiply-adds
+    were contracted); that is their sensitivity to round-off,
     not a difference of method: perturbing the initial positions of this integrator alone by
     1e-16 (relative) moves its own step sizes by 1.4e-11 to 1.8e-11. A step-size rule off by
     a constant factor would differ by that factor (with 7!/2 in place of 7! in the rule, the
     steps are 10% shorter and this test fails). Both then land on t = 15000 days, where the
-    states agree to 1.1e-14 (positions) and 1.2e-14 (velocities), measured."""
+    states agree to 8.5e-15 (positions) and 9.7e-15 (velocities), measured."""
     sim = solar()
     state, model, work, memory = kernel(sim)
     r = rebound_sim(problems.outer_solar_system(), SOLAR_DT, 1e-9)
@@ -203,11 +205,15 @@ def test_energy_error_follows_brouwers_law():
     """16 orientations of an e = 0.5 orbit, 1500 orbits each (about 6-9 s here), epsilon 1e-9.
 
     Measured: growth exponent 0.47-0.51 for six different sets of orientations; rms relative
-    energy error after 1500 orbits 5-7e-15, largest single error 1-2e-14. The estimator does
+    energy error after 1500 orbits 5-7e-15, largest single error 1-2e-14; with the kernel's
+    multiply-adds contracted, on these orientations: exponent 0.477, rms 3.1e-15, largest
+    9.8e-15. The estimator does
     see a drift: the same errors plus 4e-17 per orbit give an exponent near 1.
     Over 1e5 orbits (5 runs, 27 s each, outside pytest): rms error 5.4e-14 at 1e5 orbits
     (5.8e-15 at 1e3), largest 1.1e-13, exponent 0.47 (this estimator) and 0.42-0.50 (a fit of
-    the ensemble rms against time from 10, 100, 1000 orbits)."""
+    the ensemble rms against time from 10, 100, 1000 orbits). Again with contracted
+    multiply-adds: rms 6.8e-14 at 1e5 orbits (5.8e-15 at 1e3), largest 1.2e-13, exponent 0.50
+    (this estimator), 0.43 (the fit from 10 to 1000 orbits) and 0.50 (from 10 to 1e5)."""
     orbits = 1500
     runs = [_kepler_energy_errors(2.0 * math.pi * m / 16 + 0.1, orbits) for m in range(16)]
     n = min(len(errs) for _, errs in runs)
@@ -232,10 +238,11 @@ def _two_body_energy(m1, m2, x1, x2, v1, v2):
 def test_pythagorean_problem_m3_escapes():
     """Burrau's problem to t = 70 (Szebehely & Peters 1967): after the close encounters the
     lightest body (m = 3) leaves on an unbound orbit and m = 4, 5 remain a bound binary.
-    Measured: relative energy error 1.0e-10 in 5377 steps (REBOUND's IAS15: 3.1e-11 in 5380).
+    Measured: relative energy error 1.3e-11 in 5378 steps (REBOUND's IAS15: 3.1e-11 in 5380).
     The encounters amplify round-off, so the error is a draw from a spread: twelve starts moved
-    by up to 1.1e-12 gave 1e-12 to 2.1e-10, median 3.8e-11, both with this code and with
-    divided differences that divide instead of multiplying by reciprocals. REBOUND's IAS15 ends
+    by up to 1.1e-12 gave 6e-13 to 1.2e-10, median 3.4e-11 (before the kernel's multiply-adds
+    were contracted: 1e-12 to 2.1e-10, median 3.8e-11, with divided differences that divide
+    and with ones that multiply by reciprocals). REBOUND's IAS15 ends
     with the same break-up (positions agree to 5e-3 after the chaotic encounters)."""
     p = problems.pythagorean()
     sim = problems.make_sim(p, "rk45", 0.01)
