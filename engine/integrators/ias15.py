@@ -366,6 +366,18 @@ def _forces(t, state, model, acc, work, fused):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
+def _horner(b, weights, s, w, m):
+    """w = sum_j weights[j] b_j s^j for every component (Horner in s, one vector loop per
+    coefficient): the position (``_XINV``) or velocity (``_VINV``) polynomial at a node."""
+    for c in range(m):
+        w[c] = b[6, c] * weights[6]
+    for j in range(5, -1, -1):
+        f = weights[j]
+        for c in range(m):
+            w[c] = w[c] * s + b[j, c] * f
+
+
+@njit(cache=True, error_model="numpy", inline="always")
 def _iterate(t, dt, state, model, work, vdep, mask, a0, v0, x0, u0, b, csx, csv, g, csb, acc,
              sx, sv, w, change, fused):
     """The predictor-corrector on one step attempt. Returns (status, iterations, evaluations):
@@ -427,22 +439,12 @@ def _iterate(t, dt, state, model, work, vdep, mask, a0, v0, x0, u0, b, csx, csv,
         for node in range(1, 8):
             s = _H[node]
             sdt = s * dt
-            # positions (and velocities) at the node from the current b, Horner in s
-            for c in range(m):
-                w[c] = b[6, c] * _XINV[6]
-            for j in range(5, -1, -1):
-                f = _XINV[j]
-                for c in range(m):
-                    w[c] = w[c] * s + b[j, c] * f
+            # positions (and velocities) at the node from the current b
+            _horner(b, _XINV, s, w, m)
             for c in range(m):
                 sx[c] = x0[c] + (sdt * (v0[c] + sdt * (w[c] * s + 0.5 * a0[c])) - csx[c])
             if vdep:
-                for c in range(m):
-                    w[c] = b[6, c] * _VINV[6]
-                for j in range(5, -1, -1):
-                    f = _VINV[j]
-                    for c in range(m):
-                        w[c] = w[c] * s + b[j, c] * f
+                _horner(b, _VINV, s, w, m)
                 for c in range(m):
                     sv[c] = u0[c] + (sdt * (w[c] * s + a0[c]) - csv[c])
             _forces(t + sdt, sub, model, acc2d, work, fused)

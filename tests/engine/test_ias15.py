@@ -206,8 +206,8 @@ def test_energy_error_follows_brouwers_law():
 
     Measured: growth exponent 0.47-0.51 for six different sets of orientations; rms relative
     energy error after 1500 orbits 5-7e-15, largest single error 1-2e-14; with the kernel's
-    multiply-adds contracted, on these orientations: exponent 0.477, rms 3.1e-15, largest
-    9.8e-15. The estimator does
+    multiply-adds contracted, on these orientations: exponent 0.48-0.52, rms 3.1-3.6e-15,
+    largest 8.9-9.8e-15 (two builds that differ only in which products the compiler fused). The estimator does
     see a drift: the same errors plus 4e-17 per orbit give an exponent near 1.
     Over 1e5 orbits (5 runs, 27 s each, outside pytest): rms error 5.4e-14 at 1e5 orbits
     (5.8e-15 at 1e3), largest 1.1e-13, exponent 0.47 (this estimator) and 0.42-0.50 (a fit of
