@@ -610,7 +610,7 @@ def advance(t, h, steps, state, model, work, vdep, t_end, tol, memory):
     mask = np.empty(m)
     for k in range(dim):
         mask[k * n:(k + 1) * n] = moving
-    flat = np.empty((13, m))
+    flat = np.empty((13, m))  # a0, acc, sx, sv, nx, nv, ncx, ncv, v0, x0, u0, w, change
     g = np.empty((7, m))
     csb = np.empty((7, m))
     return _advance(t, h, steps, state, model, work, vdep, t_end, tol, memory, mask, flat[0],
