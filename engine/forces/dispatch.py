@@ -23,7 +23,7 @@ from . import (blast, buoyancy, coulomb, drag, gravity, point_mass, springs, thr
                uniform_gravity, wind)
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@njit(cache=True, error_model="numpy", _nrt=False, fastmath=False)
 def accelerations(t, state, model, acc, work):
     """Overwrite ``acc[:, :n]`` with the total acceleration of every declared term at time t.
 

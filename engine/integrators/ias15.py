@@ -235,7 +235,7 @@ def _views(memory, dim, n):
 
 
 # -- small pieces ---------------------------------------------------------------------------------
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", fastmath=False)
 def root7(a):
     """a^(1/7) for a > 0 by Newton's method from above (fixed iteration count, so the result
     depends only on IEEE arithmetic, not on the platform's pow); NaN for a <= 0 or non-finite."""

@@ -279,7 +279,7 @@ def _apply_all(jp, jv, kw, first, count):
             jv[k, j] = fd * x + gd * v if ok else v
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@njit(cache=True, error_model="numpy", _nrt=False, fastmath=False)
 def _drift_column_call(jp, jv, j, mu, dt, kw):
     """``drift_column`` called, not inlined: the rare path kept out of the lockstep code."""
     dim = jp.shape[0]
