@@ -146,6 +146,8 @@ def step_count(name, value, minimum=0):
     Bools, floats, text and None are a TypeError (not a count at all, like text given as a
     number to :func:`finite_float`); a count out of range is a ValueError.
     """
+    if type(value) is int and minimum <= value <= MAX_STEPS:
+        return value  # the common call, without the abstract-class check below
     if isinstance(value, _BOOLS) or not isinstance(value, numbers.Integral):
         raise TypeError(f"{name} must be an int >= {minimum}, got {value!r} "
                         f"({type(value).__name__})")

@@ -96,8 +96,10 @@ class Simulation(DeclaresTerms):
         self._forces = []
         self._model = None
         self._model_key = None
+        self._velocity_dependent = False  # of the packed terms, found when they are packed
         self._plan = None  # whfast's and saba's plan of the scene, and what it was made from
         self._plan_key = None
+        self._plan_model = None
         # bumped by every add and remove of a force term: the packed model is keyed on it (a
         # key of the terms' id() would match a removed term's reused address)
         self._revision = 0
@@ -408,6 +410,8 @@ class Simulation(DeclaresTerms):
         key = (self._G, self._revision) + tuple(f._version for f in self._forces)
         if key != self._model_key:
             self._model = pack(self._forces, self)
+            # a term's velocity dependence follows its parameters, so it changes only with them
+            self._velocity_dependent = any(f.velocity_dependent for f in self._forces)
             self._model_key = key
         return self._model
 
@@ -489,10 +493,10 @@ class Simulation(DeclaresTerms):
         plan = None
         if self._integrator in _integrators.KEPLER_SPLITTING:
             plan = self._kepler_plan(state, model)
-        vdep = any(f.velocity_dependent for f in self._forces)
+        vdep = self._velocity_dependent
         memory = self._ias15_state(state) if self._integrator == "ias15" else None
         lattice = self._janus_exponents(state) if self._integrator == "janus" else None
-        counts = np.zeros(1, dtype=np.int64)
+        counts = np.zeros(1, dtype=np.int64) if self._integrator == "rk45" else None
         before = _ias15.statistics(memory)["evaluations"] if memory is not None else 0
         t, h_next, done, status = _integrators.advance(
             self._integrator, self._t, h, steps, state, model, vdep, t_end, self._tolerance,
@@ -511,6 +515,11 @@ class Simulation(DeclaresTerms):
         if (adaptive and not keep_dt and status < 0
                 and status != _integrators.common.TIME_OVERFLOW):
             self._dt = h_next
+        if status != _integrators.common.OK:
+            self._raise_for(status, failed_step, t, h_next, lattice)
+
+    def _raise_for(self, status, failed_step, t, h_next, lattice):
+        """The exception for an integrator's ``status`` (not OK) after a call of ``_run``."""
         if status >= 0:
             raise SimulationError(
                 f"step {failed_step} from t={t!r} with {self._integrator} gave particle {status} a "
@@ -544,14 +553,17 @@ class Simulation(DeclaresTerms):
         it depends on changed: the terms and their parameters, the particles' masses and
         flags (all of which the user may write between calls)."""
         n = state.n
-        key = (self._integrator, self._coordinates, self._revision, id(model), n, state.box,
-               model.params.tobytes(), state.mass[:n].tobytes(), state.active[:n].tobytes(),
-               state.test[:n].tobytes(), state.pinned[:n].tobytes())
-        if key != self._plan_key:
+        # the model by identity (a repacked one is a new object; nothing writes a simulation's
+        # packed parameters in place), the particles' arrays by content (the user may)
+        key = (self._integrator, self._coordinates, self._revision, n, state.box,
+               state.mass[:n].tobytes(), state.active[:n].tobytes(), state.test[:n].tobytes(),
+               state.pinned[:n].tobytes())
+        if key != self._plan_key or self._plan_model is not model:
             self._plan = wisdom_holman.plan(self._forces, state, model,
                                             lambda terms: pack(terms, self), self._integrator,
-                                            self._coordinates)
+                                            self._coordinates, direct=True)
             self._plan_key = key
+            self._plan_model = model
         return self._plan
 
     def _evaluations_per_step(self):

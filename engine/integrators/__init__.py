@@ -54,11 +54,6 @@ def check_name(name):
     return name
 
 
-_WH_DRIFTS = np.array(wisdom_holman.WH[0])
-_WH_KICKS = np.array(wisdom_holman.WH[1])
-_NO_CORRECTOR = wisdom_holman.corrector_table(0)
-
-
 def _dispatch_call(dispatcher, args):
     return dispatcher(*args)
 
@@ -81,25 +76,9 @@ def advance(name, t, h, steps, state, model, vdep, t_end=np.nan, tol=1e-9, work=
         work = workspace(state.n)
     run = _direct.call if direct else _dispatch_call
     if name in ("whfast", "saba"):
-        if plan.mode == wisdom_holman.DEMOCRATIC and (name == "saba" or corrector != 0
-                                                      or kernel != "standard"):
-            raise ValueError(
-                "democratic heliocentric coordinates take whfast's standard kernel without "
-                f"corrector (got integrator={name!r}, corrector={corrector!r}, kernel={kernel!r}): "
-                "the correctors, the lazy kernel and SABA are built for Jacobi coordinates; "
-                "nothing was changed")
-        if name == "whfast":
-            kernel_code, table = wisdom_holman.KERNELS[kernel], wisdom_holman.corrector_table(corrector)
-            drifts, kicks, cc = _WH_DRIFTS, _WH_KICKS, 0.0
-        else:
-            kernel_code, table = wisdom_holman.KERNEL_STANDARD, _NO_CORRECTOR
-            drifts, kicks, cc = wisdom_holman.saba_scheme(saba)
-        mode, order, masses, G, mu, center, attracted = plan.arguments()
         return run(wisdom_holman.advance,
                    (float(t), float(h), int(steps), state, plan.kick_model, work, bool(vdep),
-                    float(t_end), int(mode), order, masses, float(G), float(mu), center,
-                    attracted, bool(plan.kick_com), int(kernel_code), table, drifts, kicks,
-                    float(cc)))
+                    float(t_end)) + plan.kernel_tail(name, corrector, kernel, saba))
     if name in _COEFFICIENTS:
         return splitting.advance(t, h, steps, state, model, work, vdep, t_end, *_COEFFICIENTS[name])
     if name == "euler":

@@ -47,10 +47,11 @@ import math
 import numpy as np
 from numba import njit
 
-from ..forces.dispatch import accelerations_inline
+from ..forces.dispatch import EMPTY_MODEL, accelerations_inline
 from ..forces.gravity import NBodyGravity
 from ..forces.point_mass import PointMass
 from ..space import wrap_scalar
+from . import direct as _direct
 from .common import OK, all_finite
 from .kepler_drift import SCRATCH_ROWS, drift_columns
 
@@ -335,7 +336,7 @@ def _democratic_kick(t, h, jp, jv, state, kick_model, work, m, order, count, eta
 
 
 # -- the two operators ------------------------------------------------------------------------
-@njit(cache=True, error_model="numpy", _nrt=False)
+@njit(cache=True, error_model="numpy", inline="always")
 def _kepler_drift(mode, jp, jv, mu, count, h, kw, box):
     """Every moving body along its Kepler orbit for time h (mu[j] = 0: a straight line;
     ``kepler_drift.drift_columns``, ``kw`` its scratch); in JACOBI mode column 0, the centre
@@ -525,6 +526,27 @@ def _kick(mode, t, h, jp, jv, state, kick_model, work, m, order, count, eta, mu,
             jv[k, j] += h * ja[k, j]
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def _kick_step(mode, t, h, jp, jv, state, kick_model, work, m, order, count, eta, mu, center,
+               acc, ja, kick_com, kernel, shifted, vdep, mo, xs, ad, massive, G):
+    """``_kick``, with its two common cases taken without calling it: nothing to kick
+    (ATTRACTOR mode, the attractor the only term) and mutual gravity alone with the standard
+    kernel (``_gravity_interaction``, then v' += h a'). A call passes each of its arrays as
+    its parts (pointers, shape, strides): ``_kick``'s two dozen arguments cost about as much
+    as a small system's Kepler drift, measured, so the step loop calls it only for the rest."""
+    if mode == ATTRACTOR and kick_model.kinds.shape[0] == 0:
+        return
+    if mode == JACOBI_GRAVITY and kernel == KERNEL_STANDARD:
+        _gravity_interaction(jp, mo, count, massive, eta, mu, G, xs, ad, ja)
+        dim = jp.shape[0]
+        for j in range(count):
+            for k in range(dim):
+                jv[k, j] += h * ja[k, j]
+        return
+    _kick(mode, t, h, jp, jv, state, kick_model, work, m, order, count, eta, mu, center, acc, ja,
+          kick_com, kernel, shifted, vdep, mo, xs, ad, massive, G)
+
+
 @njit(cache=True, error_model="numpy", _nrt=False)
 def _corrector(table, sign, h, mode, t, jp, jv, state, kick_model, work, m, order, count, eta,
                mu, center, acc, ja, kick_com, kw, shifted, vdep, mo, xs, ad, massive, G):
@@ -536,11 +558,13 @@ def _corrector(table, sign, h, mode, t, jp, jv, state, kick_model, work, m, orde
         a = table[row, 0] * h
         b = sign * table[row, 1] * h
         _kepler_drift(mode, jp, jv, mu, count, a, kw, state.box)
-        _kick(mode, t, -b, jp, jv, state, kick_model, work, m, order, count, eta, mu, center,
-              acc, ja, kick_com, KERNEL_STANDARD, shifted, vdep, mo, xs, ad, massive, G)
+        _kick_step(mode, t, -b, jp, jv, state, kick_model, work, m, order, count, eta, mu,
+                   center, acc, ja, kick_com, KERNEL_STANDARD, shifted, vdep, mo, xs, ad,
+                   massive, G)
         _kepler_drift(mode, jp, jv, mu, count, -2.0 * a, kw, state.box)
-        _kick(mode, t, b, jp, jv, state, kick_model, work, m, order, count, eta, mu, center,
-              acc, ja, kick_com, KERNEL_STANDARD, shifted, vdep, mo, xs, ad, massive, G)
+        _kick_step(mode, t, b, jp, jv, state, kick_model, work, m, order, count, eta, mu,
+                   center, acc, ja, kick_com, KERNEL_STANDARD, shifted, vdep, mo, xs, ad,
+                   massive, G)
         _kepler_drift(mode, jp, jv, mu, count, a, kw, state.box)
 
 
@@ -690,9 +714,9 @@ def _steps(t, h, steps, state, kick_model, work, vdep, mode, order, m, G, mu_att
                 save_v[k, j] = jv[k, j]
         elapsed = drifts[0]
         for s in range(stages):
-            _kick(mode, t + elapsed * h, kicks[s] * h, jp, jv, state, kick_model, work, m,
-                  order, count, eta, mu, center, acc, ja, kick_com, kernel, shifted, vdep, mo, xs,
-                  ad, massive, G)
+            _kick_step(mode, t + elapsed * h, kicks[s] * h, jp, jv, state, kick_model, work,
+                       m, order, count, eta, mu, center, acc, ja, kick_com, kernel, shifted,
+                       vdep, mo, xs, ad, massive, G)
             if s < stages - 1:
                 _kepler_drift(mode, jp, jv, mu, count, drifts[s + 1] * h, kw, state.box)
                 elapsed += drifts[s + 1]
@@ -749,6 +773,9 @@ def _steps(t, h, steps, state, kick_model, work, vdep, mode, order, m, G, mu_att
 # -- the schemes: Wisdom-Holman and the SABA family -----------------------------------------------
 #: drift and kick coefficients (fractions of h) of ``whfast``: drift-kick-drift
 WH = ((0.5, 0.5), (1.0,))
+_WH_DRIFTS = np.array(WH[0])
+_WH_KICKS = np.array(WH[1])
+_NO_CORRECTOR = corrector_table(0)
 
 
 def _symmetric(half_drifts, half_kicks, stages):
@@ -893,13 +920,41 @@ class Plan:
         self.mode, self.order, self.masses, self.G = mode, order, masses, G
         self.mu, self.center, self.attracted = mu, center, attracted
         self.kick_model, self.kick_com = kick_model, kick_com
+        self._tails = {}
 
     def arguments(self):
         return (self.mode, self.order, self.masses, self.G, self.mu, self.center,
                 self.attracted)
 
+    def kernel_tail(self, name, corrector, kernel, saba):
+        """The arguments of ``advance`` after ``t_end`` for integrator ``name`` (``whfast``
+        with ``corrector`` and ``kernel``, or ``saba`` with method ``saba``), converted to the
+        types its compiled version takes; made once per plan and setting, since a simulation
+        stepping in short calls would otherwise rebuild them every call."""
+        key = (name, corrector, kernel, saba)
+        tail = self._tails.get(key)
+        if tail is None:
+            if self.mode == DEMOCRATIC and (name == "saba" or corrector != 0
+                                            or kernel != "standard"):
+                raise ValueError(
+                    "democratic heliocentric coordinates take whfast's standard kernel without "
+                    f"corrector (got integrator={name!r}, corrector={corrector!r}, "
+                    f"kernel={kernel!r}): the correctors, the lazy kernel and SABA are built for "
+                    "Jacobi coordinates; nothing was changed")
+            if name == "whfast":
+                kernel_code, table = KERNELS[kernel], corrector_table(corrector)
+                drifts, kicks, cc = _WH_DRIFTS, _WH_KICKS, 0.0
+            else:
+                kernel_code, table = KERNEL_STANDARD, _NO_CORRECTOR
+                drifts, kicks, cc = saba_scheme(saba)
+            tail = (int(self.mode), self.order, self.masses, float(self.G), float(self.mu),
+                    self.center, self.attracted, bool(self.kick_com), int(kernel_code), table,
+                    drifts, kicks, float(cc))
+            self._tails[key] = tail
+        return tail
 
-def plan(terms, state, model, pack_terms, name="whfast", coordinates="jacobi"):
+
+def plan(terms, state, model, pack_terms, name="whfast", coordinates="jacobi", direct=False):
     """The Wisdom-Holman plan for a scene, or ValueError naming why it has none.
 
     ``terms`` are the declared force terms (in model order), ``pack_terms(list)`` packs a
@@ -907,13 +962,18 @@ def plan(terms, state, model, pack_terms, name="whfast", coordinates="jacobi"):
     ``PointMass`` (without softening) makes ATTRACTOR mode; otherwise a single
     ``NBodyGravity`` (without softening, in open space) whose heaviest body dominates
     (``DOMINANCE``) makes JACOBI mode, or DEMOCRATIC mode with ``coordinates``
-    ``"democratic_heliocentric"``."""
+    ``"democratic_heliocentric"``. ``direct``: ``state`` and ``model`` are a ``Simulation``'s
+    own (``engine.integrators.direct``), so the compiled helpers skip numba's type dispatch."""
     if coordinates not in COORDINATES:
         raise ValueError(f"coordinates must be one of {', '.join(map(repr, COORDINATES))}, "
                          f"got {coordinates!r}")
     n = state.n
-    attractors = [s for s, term in enumerate(terms) if isinstance(term, PointMass)]
-    gravities = [s for s, term in enumerate(terms) if isinstance(term, NBodyGravity)]
+    attractors, gravities = [], []
+    for s, term in enumerate(terms):
+        if isinstance(term, PointMass):
+            attractors.append(s)
+        elif isinstance(term, NBodyGravity):
+            gravities.append(s)
     dim = state.pos.shape[0]
     if len(attractors) > 1:
         raise ValueError(f"{name} drifts about one attractor; this scene declares "
@@ -927,11 +987,12 @@ def plan(terms, state, model, pack_terms, name="whfast", coordinates="jacobi"):
                              f"softening must be 0, got {eps2 ** 0.5!r}")
         center = model.params[f0 + 2:f0 + 2 + dim].copy()
         i0, i1 = model.index_offsets[s], model.index_offsets[s + 1]
-        order, attracted = _attractor_columns(state.active, state.pinned,
-                                              model.indices[i0:i1], n)
-        others = [term for k, term in enumerate(terms) if k != s]
+        columns_args = (state.active, state.pinned, model.indices[i0:i1], int(n))
+        order, attracted = (_direct.call(_attractor_columns, columns_args) if direct
+                            else _attractor_columns(*columns_args))
+        others = terms[:s] + terms[s + 1:]
         return Plan(ATTRACTOR, order, _NO_MASSES, 0.0, mu, center, attracted,
-                    pack_terms(others), True)
+                    pack_terms(others) if others else EMPTY_MODEL, True)
     if len(gravities) != 1:
         raise ValueError(f"{name} needs a dominant mass to drift about: declare a PointMass "
                          "attractor, or NBodyGravity with one body much heavier than the rest"
@@ -947,8 +1008,10 @@ def plan(terms, state, model, pack_terms, name="whfast", coordinates="jacobi"):
         raise ValueError(f"{name} in {coordinates.replace('_', ' ')} coordinates needs open space, "
                          f"got box={state.box!r} "
                          "(a PointMass attractor may sit in a periodic space)")
-    order, masses, heaviest, rest, massive, pinned_active = _jacobi_columns(
-        state.active, state.pinned, state.test, state.mass, n)
+    columns_args = (state.active, state.pinned, state.test, state.mass, int(n))
+    order, masses, heaviest, rest, massive, pinned_active = (
+        _direct.call(_jacobi_columns, columns_args) if direct
+        else _jacobi_columns(*columns_args))
     if pinned_active >= 0:
         raise ValueError(f"{name} in {coordinates.replace('_', ' ')} coordinates moves every body: "
                          f"particle {pinned_active} is "
