@@ -407,7 +407,7 @@ class Simulation(DeclaresTerms):
 
     # -- forces ----------------------------------------------------------------------
     def _current_model(self):
-        key = (self._G, self._revision) + tuple(f._version for f in self._forces)
+        key = (self._G, self._revision, *[f._version for f in self._forces])
         if key != self._model_key:
             self._model = pack(self._forces, self)
             # a term's velocity dependence follows its parameters, so it changes only with them

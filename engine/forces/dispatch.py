@@ -136,6 +136,16 @@ def pack(terms, sim):
         term._check(sim)
     if not terms:
         return EMPTY_MODEL
+    if len(terms) == 1:
+        # the common scene, taken straight through (this runs on a simulation's first call,
+        # where each small numpy call adds to what a short run costs): the term's own arrays,
+        # copied (a term's may be shared)
+        params, indices = terms[0]._pack(sim)
+        params = np.array(params, dtype=np.float64, order="C")
+        indices = np.array(indices, dtype=np.int64, order="C")
+        kinds, param_offsets, index_offsets = _layout((terms[0].KIND,), (0, params.shape[0]),
+                                                      (0, indices.shape[0]))
+        return Model(kinds, params, param_offsets, indices, index_offsets)
     param_blocks, index_blocks = [], []
     param_ends, index_ends = [0], [0]
     for term in terms:
@@ -150,9 +160,6 @@ def pack(terms, sim):
         index_ends.append(index_ends[-1] + indices.shape[0])
     kinds, param_offsets, index_offsets = _layout(tuple(term.KIND for term in terms),
                                                   tuple(param_ends), tuple(index_ends))
-    if len(terms) == 1:  # the common scene: its own arrays, copied (a term's may be shared)
-        params, indices = param_blocks[0].copy(), index_blocks[0].copy()
-    else:
-        params = np.concatenate(param_blocks)
-        indices = np.concatenate(index_blocks)
+    params = np.concatenate(param_blocks)
+    indices = np.concatenate(index_blocks)
     return Model(kinds, params, param_offsets, indices, index_offsets)
