@@ -330,6 +330,78 @@ def test_democratic_heliocentric_refuses_what_it_does_not_support():
         Simulation(dim=2, coordinates="heliocentric")
 
 
+def test_settings_changed_between_calls_take_effect_at_the_next_call():
+    """A simulation keeps the kernel's converted arguments per setting (the plan's
+    ``kernel_tail``): changing the corrector, the kernel or the coordinates between calls must
+    still step exactly as a simulation made with the new setting does from the same state, and
+    a setting democratic coordinates refuse is refused after calls that were allowed."""
+    settings = [("corrector", 0), ("corrector", 11), ("kernel", "lazy"), ("corrector", 0),
+                ("kernel", "standard")]
+    changed = solar()
+    for name, value in settings:
+        setattr(changed, name, value)
+        fresh = solar(corrector=changed.corrector, kernel=changed.kernel)
+        fresh.pos[:] = changed.pos
+        fresh.vel[:] = changed.vel
+        changed.step(7)
+        fresh.step(7)
+        assert np.array_equal(changed.pos, fresh.pos) and np.array_equal(changed.vel, fresh.vel)
+    sim = solar_democratic()
+    sim.step(3)
+    before = sim.pos.copy()
+    sim.corrector = 11
+    with pytest.raises(ValueError, match="democratic heliocentric coordinates take"):
+        sim.step(1)
+    assert np.array_equal(sim.pos, before)
+    sim.corrector = 0
+    sim.step(1)
+    assert sim.steps == 4
+
+
+def test_what_the_user_changes_between_calls_is_planned_again():
+    """The plan (which body drifts about which mass) is kept between calls while nothing it
+    depends on changed: the attractor's mu and position written between calls, a mass written
+    into ``sim.mass``, a particle pinned and the simulation's G changed must each act from the
+    next call on, exactly as in a simulation made that way from the same state."""
+    def attractor_scene(mu, centre):
+        sim = Simulation(dim=2, integrator="whfast", dt=0.05)
+        sim.add(pos=[1.0, 0.0], vel=[0.0, 1.1])
+        sim.add(pos=[-1.5, 0.2], vel=[0.1, -0.8])
+        star = forces.PointMass(mu=mu, pos=centre)
+        sim.add_force(star)
+        return sim, star
+
+    def same_next_call(changed, fresh):
+        fresh.pos[:] = changed.pos
+        fresh.vel[:] = changed.vel
+        changed.step(5)
+        fresh.step(5)
+        assert np.array_equal(changed.pos, fresh.pos) and np.array_equal(changed.vel, fresh.vel)
+
+    changed, star = attractor_scene(1.0, (0.0, 0.0))
+    changed.step(5)
+    star.mu = 1.3
+    same_next_call(changed, attractor_scene(1.3, (0.0, 0.0))[0])
+    star.pos = (0.1, -0.2)
+    same_next_call(changed, attractor_scene(1.3, (0.1, -0.2))[0])
+    changed.pin(1)
+    fresh = attractor_scene(1.3, (0.1, -0.2))[0]
+    fresh.pin(1)
+    same_next_call(changed, fresh)
+
+    changed = solar()
+    changed.step(5)
+    changed.mass[1] *= 2.0
+    fresh = solar()
+    fresh.mass[1] *= 2.0
+    same_next_call(changed, fresh)
+    changed.G *= 1.01  # the terms packed again with the new G (NBodyGravity's G is sim.G)
+    fresh = solar()
+    fresh.mass[1] *= 2.0
+    fresh.G *= 1.01
+    same_next_call(changed, fresh)
+
+
 def test_the_plan_orders_the_columns():
     """The Jacobi columns: the heaviest body first, the other massive ones in index order,
     then the moving massless ones (test particles count as massless); inactive particles are
