@@ -922,10 +922,6 @@ class Plan:
         self.kick_model, self.kick_com = kick_model, kick_com
         self._tails = {}
 
-    def arguments(self):
-        return (self.mode, self.order, self.masses, self.G, self.mu, self.center,
-                self.attracted)
-
     def kernel_tail(self, name, corrector, kernel, saba):
         """The arguments of ``advance`` after ``t_end`` for integrator ``name`` (``whfast``
         with ``corrector`` and ``kernel``, or ``saba`` with method ``saba``), converted to the
