@@ -674,6 +674,61 @@ def advance(t, h, steps, state, kick_model, work, vdep, t_end, mode, order, m, G
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
+def _gravity_steps(t, h, steps, jp, jv, save_p, save_v, mo, count, massive, eta, mu, G, xs, ad,
+                   ja, kw, kick, merged, last):
+    """``_steps``' loop for its most common case (mutual gravity alone, the standard kernel,
+    one kick a step and no corrector between steps: ``whfast`` on planets), the same
+    operations in the same order, so the same bits. Returns ``(t, done, bad)``, ``bad`` the
+    first column that is not finite after the step that failed (-1: none).
+
+    Why a loop of its own: inside ``_steps``, which takes every mode, scheme and corrector, the
+    same step of the outer solar system ran 8-20% slower than in this small function (measured
+    in separate processes, alternating); the large function's loop pays for its generality
+    on every step."""
+    dim = jp.shape[0]
+    done = 0
+    for step in range(steps):
+        for j in range(count):
+            for k in range(dim):
+                save_p[k, j] = jp[k, j]
+                save_v[k, j] = jv[k, j]
+        _gravity_interaction(jp, mo, count, massive, eta, mu, G, xs, ad, ja)
+        for j in range(count):
+            for k in range(dim):
+                jv[k, j] += kick * ja[k, j]
+        d = last if step == steps - 1 else merged
+        for k in range(dim):
+            jp[k, 0] += d * jv[k, 0]
+        drift_columns(jp, jv, 1, count, mu, d, kw)
+        if not all_finite(jp, jv, count):
+            return t, done, _first_bad_column(jp, jv, count)
+        t = t + h
+        done += 1
+    return t, done, -1
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _free_steps(t, h, steps, jp, jv, save_p, save_v, count, mu, kw, merged, last, box):
+    """``_steps``' loop when nothing is kicked (ATTRACTOR mode, the attractor the only term:
+    test particles about a star, a lone Kepler orbit) and no corrector stands between steps:
+    each step one Kepler drift per column, as ``_gravity_steps`` for its case."""
+    dim = jp.shape[0]
+    done = 0
+    for step in range(steps):
+        for j in range(count):
+            for k in range(dim):
+                save_p[k, j] = jp[k, j]
+                save_v[k, j] = jv[k, j]
+        _kepler_drift(ATTRACTOR, jp, jv, mu, count, last if step == steps - 1 else merged, kw,
+                      box)
+        if not all_finite(jp, jv, count):
+            return t, done, _first_bad_column(jp, jv, count)
+        t = t + h
+        done += 1
+    return t, done, -1
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
 def _steps(t, h, steps, state, kick_model, work, vdep, mode, order, m, G, mu_attractor, center,
            attracted, kick_com, kernel, corrector, drifts, kicks, cc, jp, jv, save_p, save_v,
            shifted, ja, ja0, eta, mu, acc, kw, mo, xs, ad, first_p, first_v):
@@ -706,6 +761,22 @@ def _steps(t, h, steps, state, kick_model, work, vdep, mode, order, m, G, mu_att
     status = OK
     if not all_finite(jp, jv, count):  # after this, each step's end is checked
         status = order[_first_bad_column(jp, jv, count)]
+        steps = 0
+    # the two common cases take their own loops (see there); the loop below takes the rest
+    if (mode == JACOBI_GRAVITY and kernel == KERNEL_STANDARD and cc == 0.0 and stages == 1
+            and status == OK):
+        t, done, bad = _gravity_steps(t, h, steps, jp, jv, save_p, save_v, mo, count, massive,
+                                      eta, mu, G, xs, ad, ja, kw, kicks[0] * h,
+                                      (drifts[1] + drifts[0]) * h, drifts[1] * h)
+        if bad >= 0:
+            status = order[bad]
+        steps = 0
+    elif (mode == ATTRACTOR and kick_model.kinds.shape[0] == 0 and cc == 0.0 and stages == 1
+          and status == OK):
+        t, done, bad = _free_steps(t, h, steps, jp, jv, save_p, save_v, count, mu, kw,
+                                   (drifts[1] + drifts[0]) * h, drifts[1] * h, state.box)
+        if bad >= 0:
+            status = order[bad]
         steps = 0
     for step in range(steps):
         for j in range(count):
