@@ -673,6 +673,15 @@ def advance(t, h, steps, state, kick_model, work, vdep, t_end, mode, order, m, G
                   first_v)
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def _save_columns(jp, jv, save_p, save_v, count):
+    """The coordinates a step starts from, kept: a step that fails is undone from them."""
+    for j in range(count):
+        for k in range(jp.shape[0]):
+            save_p[k, j] = jp[k, j]
+            save_v[k, j] = jv[k, j]
+
+
 @njit(cache=True, error_model="numpy", _nrt=False)
 def _gravity_steps(t, h, steps, jp, jv, save_p, save_v, mo, count, massive, eta, mu, G, xs, ad,
                    ja, kw, kick, merged, last):
@@ -688,10 +697,7 @@ def _gravity_steps(t, h, steps, jp, jv, save_p, save_v, mo, count, massive, eta,
     dim = jp.shape[0]
     done = 0
     for step in range(steps):
-        for j in range(count):
-            for k in range(dim):
-                save_p[k, j] = jp[k, j]
-                save_v[k, j] = jv[k, j]
+        _save_columns(jp, jv, save_p, save_v, count)
         _gravity_interaction(jp, mo, count, massive, eta, mu, G, xs, ad, ja)
         for j in range(count):
             for k in range(dim):
@@ -712,13 +718,9 @@ def _free_steps(t, h, steps, jp, jv, save_p, save_v, count, mu, kw, merged, last
     """``_steps``' loop when nothing is kicked (ATTRACTOR mode, the attractor the only term:
     test particles about a star, a lone Kepler orbit) and no corrector stands between steps:
     each step one Kepler drift per column, as ``_gravity_steps`` for its case."""
-    dim = jp.shape[0]
     done = 0
     for step in range(steps):
-        for j in range(count):
-            for k in range(dim):
-                save_p[k, j] = jp[k, j]
-                save_v[k, j] = jv[k, j]
+        _save_columns(jp, jv, save_p, save_v, count)
         _kepler_drift(ATTRACTOR, jp, jv, mu, count, last if step == steps - 1 else merged, kw,
                       box)
         if not all_finite(jp, jv, count):
@@ -779,10 +781,7 @@ def _steps(t, h, steps, state, kick_model, work, vdep, mode, order, m, G, mu_att
             status = order[bad]
         steps = 0
     for step in range(steps):
-        for j in range(count):
-            for k in range(dim):
-                save_p[k, j] = jp[k, j]
-                save_v[k, j] = jv[k, j]
+        _save_columns(jp, jv, save_p, save_v, count)
         elapsed = drifts[0]
         for s in range(stages):
             _kick_step(mode, t + elapsed * h, kicks[s] * h, jp, jv, state, kick_model, work,
