@@ -426,41 +426,28 @@ def test_the_plan_orders_the_columns():
 
 
 # -- the step loops of the common cases -----------------------------------------------------------
-@pytest.mark.parametrize("loop", ["gravity", "free"])
-def test_the_common_cases_loops_stop_at_the_step_that_fails_with_its_start_kept(loop):
-    """``_gravity_steps`` and ``_free_steps`` (the loops ``_steps`` gives mutual gravity alone
-    and a lone attractor) end at the first step whose end is not finite: the steps done before
-    it counted, the time advanced by exactly those, the failing column named, and the state the
-    failing step began from left in the saved columns (which ``_steps`` restores from)."""
-    from engine.integrators.kepler_drift import SCRATCH_ROWS
-    count, h = 3, 1.0
-    jp = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 2.0], [0.0, 0.0, 0.0]])
-    jv = np.array([[0.0, 0.0, 1e307], [0.0, 1.0, 0.0], [0.0, 0.0, 0.0]])
-    # column 2 on a straight line (mu 0) at 1e307 per unit time: its x passes the largest float
-    # (1.8e308) during the step that starts at x = 5e306 + 17e307
-    mu = np.array([0.0, 1.0, 0.0])
-    save_p, save_v = np.empty_like(jp), np.empty_like(jv)
-    kw = np.empty((SCRATCH_ROWS, 3))
-    start = jp.copy()
-    for k in range(3):  # the first half drift, as _steps takes it before its loop
-        start[k, 0] += 0.5 * h * jv[k, 0]
-    start[0, 2] += 0.5 * h * jv[0, 2]
-    jp = start.copy()
-    if loop == "gravity":
-        mo = np.array([[1.0, 0.0, 0.0], [1.0, 1.0, 1.0]])  # massless columns: no mutual pull
-        eta = np.ones(count)
-        scratch = [np.empty_like(jp) for _ in range(3)]
-        t, done, bad = wisdom_holman._gravity_steps(0.25, h, 40, jp, jv, save_p, save_v, mo,
-                                                    count, 1, eta, mu, 1.0, *scratch, kw, h,
-                                                    h, 0.5 * h)
-    else:
-        t, done, bad = wisdom_holman._free_steps(0.25, h, 40, jp, jv, save_p, save_v, count, mu,
-                                                 kw, h, 0.5 * h, 0.0)
-    assert (done, bad) == (17, 2)
-    expected_t = 0.25
-    for _ in range(17):
-        expected_t = expected_t + h
-    assert t == expected_t
-    assert abs(save_p[0, 2] / (5e306 + 17e307) - 1.0) < 1e-15  # where the failing step began
-    assert np.all(np.isfinite(save_p)) and np.all(np.isfinite(save_v))
-    assert not np.isfinite(jp[0, 2])
+def test_a_lone_attractors_loop_stops_at_the_step_that_fails_and_keeps_the_last_finite_state():
+    """The loop a lone attractor takes (nothing to kick) ends at the first step whose end is not
+    finite: particle 1, outside the attractor's list, moves on a straight line at 1e307 per
+    unit time from x = 5e306 (after the first half drift), and passes the largest float
+    (1.8e308) during step 18. Seventeen steps count, the time is theirs, the particle is
+    named, and the state kept is the last finite one (step 17's, to round-off: it is found by
+    drifting back the half drift the failed step began with)."""
+    def scene():
+        sim = Simulation(dim=2, integrator="whfast", dt=1.0)
+        sim.add(mass=1.0, pos=(1.0, 0.0), vel=(0.0, 1.0))
+        sim.add(mass=1.0, pos=(0.0, 2.0), vel=(1e307, 0.0))
+        sim.add_force(forces.PointMass(mu=1.0, particles=[0]))
+        return sim
+    sim = scene()
+    with pytest.raises(engine.SimulationError) as info:
+        sim.step(40)
+    assert (info.value.step, info.value.particle, sim.steps, sim.t) == (17, 1, 17, 17.0)
+    assert np.all(np.isfinite(sim.pos)) and np.all(np.isfinite(sim.vel))
+    clean = Simulation(dim=2, integrator="whfast", dt=1.0)
+    clean.add(mass=1.0, pos=(1.0, 0.0), vel=(0.0, 1.0))
+    clean.add_force(forces.PointMass(mu=1.0))
+    clean.step(17)
+    np.testing.assert_allclose(sim.pos[0], clean.pos[0], rtol=0, atol=1e-14)
+    np.testing.assert_allclose(sim.vel[0], clean.vel[0], rtol=0, atol=1e-14)
+    assert sim.pos[1, 0] == pytest.approx(17e307, rel=1e-15) and sim.pos[1, 1] == 2.0
