@@ -47,7 +47,9 @@ _R72, _R90, _R110, _R132, _R156, _R182, _R210 = (1 / 72, 1 / 90, 1 / 110, 1 / 13
 def stumpff(z):
     """c0(z), c1(z), c2(z), c3(z) by the series at small |z| and quadruple-argument steps."""
     quarterings = 0
-    while abs(z) > 0.1:
+    # an infinite z (an orbit blown up to overflow) would be quartered for ever: it leaves the
+    # loop as it is, and the solver's checks then find the state not finite
+    while 0.1 < abs(z) < math.inf:
         z *= 0.25
         quarterings += 1
     # the series' ratios as products by reciprocals: no division in the hot path

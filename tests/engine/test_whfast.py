@@ -451,3 +451,19 @@ def test_a_lone_attractors_loop_stops_at_the_step_that_fails_and_keeps_the_last_
     np.testing.assert_allclose(sim.pos[0], clean.pos[0], rtol=0, atol=1e-14)
     np.testing.assert_allclose(sim.vel[0], clean.vel[0], rtol=0, atol=1e-14)
     assert sim.pos[1, 0] == pytest.approx(17e307, rel=1e-15) and sim.pos[1, 1] == 2.0
+
+
+def test_a_drift_that_overflows_raises_instead_of_hanging():
+    """A massless body at 1e150 per unit time, stepped by 1e157: its Kepler drift's z = beta X^2
+    overflows to infinity, which the Stumpff functions' quartering loop used to quarter for
+    ever (the call never returned). Now the step fails as any non-finite step does: a
+    SimulationError, and a failing first step changes nothing."""
+    sim = Simulation(dim=2, integrator="whfast", dt=1e157)
+    sim.add(mass=1.0, pos=(0.0, 0.0))
+    sim.add(mass=1e-3, pos=(1.0, 0.0), vel=(0.0, 1.0))
+    sim.add(mass=0.0, pos=(0.0, 2.0), vel=(1e150, 0.0))
+    sim.add_force(forces.NBodyGravity())
+    before = _state(sim)
+    with pytest.raises(engine.SimulationError):
+        sim.step(5)
+    assert all(np.array_equal(a, b) for a, b in zip(before, _state(sim)))
