@@ -23,6 +23,7 @@ class Particles:
         self._allocate(max(int(capacity), 1))
 
     def _allocate(self, capacity):
+        self._state = None  # the kept State holds the old arrays
         old_n = self.n
         fresh = {
             "pos": np.zeros((self.dim, capacity)),
@@ -65,6 +66,12 @@ class Particles:
         return np.arange(s.start, s.stop)
 
     def state(self, box):
-        """The arrays as the ``engine.state.State`` the kernels take (views of this storage)."""
-        return State(self.pos, self.vel, self.mass, self.charge, self.radius, self.active,
-                     self.test, self.pinned, int(self.n), float(box))
+        """The arrays as the ``engine.state.State`` the kernels take (views of this storage),
+        made again only when the arrays, the count or ``box`` changed (a simulation stepping
+        in short calls, a game frame, asks for it on every call)."""
+        state = self._state
+        if state is None or state.box != box or state.n != self.n:
+            state = self._state = State(self.pos, self.vel, self.mass, self.charge,
+                                        self.radius, self.active, self.test, self.pinned,
+                                        int(self.n), float(box))
+        return state

@@ -1005,17 +1005,22 @@ class Plan:
                     f"corrector (got integrator={name!r}, corrector={corrector!r}, "
                     f"kernel={kernel!r}): the correctors, the lazy kernel and SABA are built for "
                     "Jacobi coordinates; nothing was changed")
-            if name == "whfast":
-                kernel_code, table = KERNELS[kernel], corrector_table(corrector)
-                drifts, kicks, cc = _WH_DRIFTS, _WH_KICKS, 0.0
-            else:
-                kernel_code, table = KERNEL_STANDARD, _NO_CORRECTOR
-                drifts, kicks, cc = saba_scheme(saba)
             tail = (int(self.mode), self.order, self.masses, float(self.G), float(self.mu),
-                    self.center, self.attracted, bool(self.kick_com), int(kernel_code), table,
-                    drifts, kicks, float(cc))
+                    self.center, self.attracted, bool(self.kick_com)) + _scheme_tail(*key)
             self._tails[key] = tail
         return tail
+
+
+@functools.lru_cache(maxsize=None)
+def _scheme_tail(name, corrector, kernel, saba):
+    """The scheme's part of ``Plan.kernel_tail`` (kernel code, corrector table, drift and kick
+    coefficients, lazy corrector coefficient), the same for every plan: made once per setting
+    in the process, since a fresh simulation's first call would otherwise build it (its
+    arrays are shared; the kernels only read them)."""
+    if name == "whfast":
+        return int(KERNELS[kernel]), corrector_table(corrector), _WH_DRIFTS, _WH_KICKS, 0.0
+    drifts, kicks, cc = saba_scheme(saba)
+    return int(KERNEL_STANDARD), _NO_CORRECTOR, drifts, kicks, float(cc)
 
 
 def plan(terms, state, model, pack_terms, name="whfast", coordinates="jacobi", direct=False):
@@ -1044,13 +1049,15 @@ def plan(terms, state, model, pack_terms, name="whfast", coordinates="jacobi", d
                          f"{len(attractors)} PointMass terms")
     if attractors:
         s = attractors[0]
-        f0 = model.param_offsets[s]
-        mu, eps2 = float(model.params[f0]), float(model.params[f0 + 1])
+        f0 = int(model.param_offsets[s])
+        # read as Python floats in one conversion (this runs on a simulation's first call,
+        # where each numpy scalar read adds to what a short run costs)
+        mu, eps2, *center = model.params[f0:f0 + 2 + dim].tolist()
         if eps2 != 0.0:
             raise ValueError(f"{name} drifts on exact Kepler orbits about the PointMass: its "
                              f"softening must be 0, got {eps2 ** 0.5!r}")
-        center = model.params[f0 + 2:f0 + 2 + dim].copy()
-        i0, i1 = model.index_offsets[s], model.index_offsets[s + 1]
+        center = np.array(center)
+        i0, i1 = model.index_offsets[s:s + 2].tolist()
         columns_args = (state.active, state.pinned, model.indices[i0:i1], int(n))
         order, attracted = (_direct.call(_attractor_columns, columns_args) if direct
                             else _attractor_columns(*columns_args))
