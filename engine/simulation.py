@@ -555,13 +555,14 @@ class Simulation(DeclaresTerms):
         n = state.n
         # the model by identity (a repacked one is a new object; nothing writes a simulation's
         # packed parameters in place), the particles' arrays by content (the user may)
-        key = (self._integrator, self._coordinates, self._revision, n, state.box,
-               state.mass[:n].tobytes(), state.active[:n].tobytes(), state.test[:n].tobytes(),
-               state.pinned[:n].tobytes())
+        particles = (state.mass[:n].tobytes(), state.active[:n].tobytes(),
+                     state.test[:n].tobytes(), state.pinned[:n].tobytes())
+        key = (self._integrator, self._coordinates, self._revision, n, state.box, particles)
         if key != self._plan_key or self._plan_model is not model:
-            self._plan = wisdom_holman.plan(self._forces, state, model,
-                                            lambda terms: pack(terms, self), self._integrator,
-                                            self._coordinates, direct=True)
+            self._plan = wisdom_holman.shared_plan(self._forces, state, model,
+                                                   lambda terms: pack(terms, self),
+                                                   self._integrator, self._coordinates,
+                                                   particles)
             self._plan_key = key
             self._plan_model = model
         return self._plan

@@ -41,6 +41,7 @@ with a_k = k sqrt(7/40) h (coefficients as published in those papers).
 Other declared terms (drag, thrust, Coulomb, springs) enter through the kick; the method is
 then of second order in h for them (its high order in the mass ratio holds only for gravity).
 """
+import collections
 import functools
 import math
 
@@ -1021,6 +1022,41 @@ def _scheme_tail(name, corrector, kernel, saba):
         return int(KERNELS[kernel]), corrector_table(corrector), _WH_DRIFTS, _WH_KICKS, 0.0
     drifts, kicks, cc = saba_scheme(saba)
     return int(KERNEL_STANDARD), _NO_CORRECTOR, drifts, kicks, float(cc)
+
+
+#: how many single-term scenes' plans a process keeps (``shared_plan``), and up to how many
+#: particles a scene's plan is kept (beyond that, making one costs little next to a step)
+SHARED_PLANS = 64
+SHARED_MAX_PARTICLES = 1024
+_SHARED = collections.OrderedDict()
+
+
+def shared_plan(terms, state, model, pack_terms, name, coordinates, particles_key):
+    """``plan(..., direct=True)`` for a ``Simulation``, shared with every simulation of the
+    process whose scene has the same content, when the scene is a single term (a PointMass
+    alone, or NBodyGravity alone) of at most ``SHARED_MAX_PARTICLES`` particles.
+
+    A plan is a function of the scene alone (the term's packed parameters, the particles'
+    count, masses and flags, the space, the coordinates), and nothing writes it, so equal
+    scenes may hold the same one: many short runs of one scene (a sweep, the advisor's pilot
+    runs, an ensemble) then make it once, where each fresh simulation's first call would
+    otherwise spend more time on it than a hundred steps of a small system take.
+    ``particles_key`` is the bytes of the masses and flags (the caller has them). The
+    least recently used plan is dropped past ``SHARED_PLANS``; a scene with more terms
+    (their parameters change from frame to frame: thrust) is planned as before."""
+    if model.kinds.shape[0] != 1 or state.n > SHARED_MAX_PARTICLES:
+        return plan(terms, state, model, pack_terms, name, coordinates, direct=True)
+    key = (name, coordinates, state.n, state.box, state.pos.shape[0], particles_key,
+           model.kinds.tobytes(), model.params.tobytes(), model.indices.tobytes())
+    made = _SHARED.get(key)
+    if made is None:
+        made = plan(terms, state, model, pack_terms, name, coordinates, direct=True)
+        _SHARED[key] = made
+        while len(_SHARED) > SHARED_PLANS:
+            _SHARED.popitem(last=False)
+    else:
+        _SHARED.move_to_end(key)
+    return made
 
 
 def plan(terms, state, model, pack_terms, name="whfast", coordinates="jacobi", direct=False):

@@ -405,6 +405,54 @@ def test_what_the_user_changes_between_calls_is_planned_again():
     same_next_call(changed, fresh)
 
 
+def test_equal_scenes_share_one_plan_and_any_difference_is_planned_on_its_own(monkeypatch):
+    """Simulations of the same single-term scene hold one plan (``shared_plan``); a scene that
+    differs in anything the plan reads (the attractor's mu or position, a mass, a test, pinned
+    or active flag) gets its own, and steps bit for bit as with a plan of its own; a scene of
+    two terms is planned per simulation; at most ``SHARED_PLANS`` plans are kept."""
+    def scene(mu=1.0, centre=(0.0, 0.0), drag=False, change=None):
+        sim = Simulation(dim=2, integrator="whfast", dt=0.05)
+        sim.add(mass=1e-3, pos=[1.0, 0.0], vel=[0.0, 1.1])
+        sim.add(mass=0.0, pos=[-1.5, 0.2], vel=[0.1, -0.8])
+        sim.add(mass=2e-3, pos=[0.3, -2.0], vel=[0.7, 0.0])
+        sim.add_force(forces.PointMass(mu=mu, pos=centre))
+        if drag:
+            sim.add_force(forces.Drag(linear=1e-3))
+        if change is not None:
+            change(sim)
+        return sim
+
+    first = scene()
+    assert scene().kepler_plan() is first.kepler_plan()
+    variants = {"mu": lambda: scene(mu=1.3), "centre": lambda: scene(centre=(0.1, 0.0)),
+                "mass": lambda: scene(change=lambda s: s.mass.__setitem__(1, 5e-4)),
+                "pinned": lambda: scene(change=lambda s: s.pin(2)),
+                "inactive": lambda: scene(change=lambda s: s.deactivate(0))}
+    shared = {}
+    for name, make in variants.items():
+        sim = make()
+        assert sim.kepler_plan() is not first.kepler_plan(), name
+        assert make().kepler_plan() is sim.kepler_plan(), name
+        sim.step(40)
+        shared[name] = (sim.pos.copy(), sim.vel.copy())
+    with monkeypatch.context() as m:
+        m.setattr(wisdom_holman, "SHARED_MAX_PARTICLES", 0)  # every scene planned on its own
+        assert scene().kepler_plan() is not first.kepler_plan()
+        for name, make in variants.items():
+            sim = make()
+            sim.step(40)
+            assert np.array_equal(sim.pos, shared[name][0]), name
+            assert np.array_equal(sim.vel, shared[name][1]), name
+    assert scene(drag=True).kepler_plan() is not scene(drag=True).kepler_plan()
+    monkeypatch.setattr(wisdom_holman, "SHARED_PLANS", 2)
+    kept = scene(mu=2.0).kepler_plan()
+    scene(mu=2.1).kepler_plan()
+    assert scene(mu=2.0).kepler_plan() is kept  # used last: kept
+    scene(mu=2.2).kepler_plan()
+    scene(mu=2.3).kepler_plan()
+    assert scene(mu=2.0).kepler_plan() is not kept  # two others used since: dropped
+
+
 def test_the_plan_orders_the_columns():
     """The Jacobi columns: the heaviest body first, the other massive ones in index order,
     then the moving massless ones (test particles count as massless); inactive particles are
