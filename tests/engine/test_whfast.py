@@ -410,10 +410,10 @@ def test_equal_scenes_share_one_plan_and_any_difference_is_planned_on_its_own(mo
     differs in anything the plan reads (the attractor's mu or position, a mass, a test, pinned
     or active flag) gets its own, and steps bit for bit as with a plan of its own; a scene of
     two terms is planned per simulation; at most ``SHARED_PLANS`` plans are kept."""
-    def scene(mu=1.0, centre=(0.0, 0.0), drag=False, change=None):
+    def scene(mu=1.0, centre=(0.0, 0.0), drag=False, change=None, test=False):
         sim = Simulation(dim=2, integrator="whfast", dt=0.05)
         sim.add(mass=1e-3, pos=[1.0, 0.0], vel=[0.0, 1.1])
-        sim.add(mass=0.0, pos=[-1.5, 0.2], vel=[0.1, -0.8])
+        sim.add(mass=0.0, pos=[-1.5, 0.2], vel=[0.1, -0.8], test=test)
         sim.add(mass=2e-3, pos=[0.3, -2.0], vel=[0.7, 0.0])
         sim.add_force(forces.PointMass(mu=mu, pos=centre))
         if drag:
@@ -426,6 +426,7 @@ def test_equal_scenes_share_one_plan_and_any_difference_is_planned_on_its_own(mo
     assert scene().kepler_plan() is first.kepler_plan()
     variants = {"mu": lambda: scene(mu=1.3), "centre": lambda: scene(centre=(0.1, 0.0)),
                 "mass": lambda: scene(change=lambda s: s.mass.__setitem__(1, 5e-4)),
+                "test": lambda: scene(test=True),
                 "pinned": lambda: scene(change=lambda s: s.pin(2)),
                 "inactive": lambda: scene(change=lambda s: s.deactivate(0))}
     shared = {}
