@@ -411,7 +411,13 @@ class Simulation(DeclaresTerms):
         if key != self._model_key:
             self._model = pack(self._forces, self)
             # a term's velocity dependence follows its parameters, so it changes only with them
-            self._velocity_dependent = any(f.velocity_dependent for f in self._forces)
+            # (a loop, not any() over a generator: this runs on a simulation's first call)
+            vdep = False
+            for f in self._forces:
+                if f.velocity_dependent:
+                    vdep = True
+                    break
+            self._velocity_dependent = vdep
             self._model_key = key
         return self._model
 
@@ -498,11 +504,15 @@ class Simulation(DeclaresTerms):
         lattice = self._janus_exponents(state) if self._integrator == "janus" else None
         counts = np.zeros(1, dtype=np.int64) if self._integrator == "rk45" else None
         before = _ias15.statistics(memory)["evaluations"] if memory is not None else 0
-        t, h_next, done, status = _integrators.advance(
-            self._integrator, self._t, h, steps, state, model, vdep, t_end, self._tolerance,
-            plan=plan, corrector=self._corrector, kernel=self._kernel, saba=self._saba,
-            memory=memory, janus_order=self._janus_order, lattice=lattice, counts=counts,
-            direct=True)
+        if plan is not None:
+            t, h_next, done, status = _integrators.advance_kepler_splitting(
+                self._integrator, self._t, h, steps, state, plan, vdep, t_end, self._corrector,
+                self._kernel, self._saba, None, True)
+        else:
+            t, h_next, done, status = _integrators.advance(
+                self._integrator, self._t, h, steps, state, model, vdep, t_end,
+                self._tolerance, memory=memory, janus_order=self._janus_order,
+                lattice=lattice, counts=counts, direct=True)
         if self._integrator == "rk45":
             self.force_evaluations += int(counts[0])
         elif memory is not None:

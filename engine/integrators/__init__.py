@@ -58,6 +58,20 @@ def _dispatch_call(dispatcher, args):
     return dispatcher(*args)
 
 
+def advance_kepler_splitting(name, t, h, steps, state, plan, vdep, t_end=np.nan, corrector=0,
+                             kernel="standard", saba=wisdom_holman.DEFAULT_SABA, work=None,
+                             direct=False):
+    """``advance`` for ``whfast`` and ``saba`` (``plan``: the scene's ``wisdom_holman.Plan``),
+    with no other integrator's arguments to pass: a ``Simulation`` stepping in short calls
+    takes this path."""
+    if work is None:
+        work = workspace(state.n)
+    run = _direct.call if direct else _dispatch_call
+    return run(wisdom_holman.advance,
+               (float(t), float(h), int(steps), state, plan.kick_model, work, bool(vdep),
+                float(t_end)) + plan.kernel_tail(name, corrector, kernel, saba))
+
+
 def advance(name, t, h, steps, state, model, vdep, t_end=np.nan, tol=1e-9, work=None,
             plan=None, corrector=0, kernel="standard", saba=wisdom_holman.DEFAULT_SABA,
             memory=None, janus_order=6, lattice=None, counts=None, direct=False):
@@ -72,13 +86,12 @@ def advance(name, t, h, steps, state, model, vdep, t_end=np.nan, tol=1e-9, work=
     ``Simulation``'s own, of fixed types, so whfast, saba and ias15 skip numba's type
     dispatch (``engine.integrators.direct``).
     """
+    if name in ("whfast", "saba"):
+        return advance_kepler_splitting(name, t, h, steps, state, plan, vdep, t_end, corrector,
+                                        kernel, saba, work, direct)
     if work is None:
         work = workspace(state.n)
     run = _direct.call if direct else _dispatch_call
-    if name in ("whfast", "saba"):
-        return run(wisdom_holman.advance,
-                   (float(t), float(h), int(steps), state, plan.kick_model, work, bool(vdep),
-                    float(t_end)) + plan.kernel_tail(name, corrector, kernel, saba))
     if name in _COEFFICIENTS:
         return splitting.advance(t, h, steps, state, model, work, vdep, t_end, *_COEFFICIENTS[name])
     if name == "euler":
