@@ -411,13 +411,7 @@ class Simulation(DeclaresTerms):
         if key != self._model_key:
             self._model = pack(self._forces, self)
             # a term's velocity dependence follows its parameters, so it changes only with them
-            # (a loop, not any() over a generator: this runs on a simulation's first call)
-            vdep = False
-            for f in self._forces:
-                if f.velocity_dependent:
-                    vdep = True
-                    break
-            self._velocity_dependent = vdep
+            self._velocity_dependent = any(f.velocity_dependent for f in self._forces)
             self._model_key = key
         return self._model
 
@@ -507,7 +501,7 @@ class Simulation(DeclaresTerms):
         if plan is not None:
             t, h_next, done, status = _integrators.advance_kepler_splitting(
                 self._integrator, self._t, h, steps, state, plan, vdep, t_end, self._corrector,
-                self._kernel, self._saba, None, True)
+                self._kernel, self._saba, direct=True)
         else:
             t, h_next, done, status = _integrators.advance(
                 self._integrator, self._t, h, steps, state, model, vdep, t_end,
