@@ -505,6 +505,38 @@ def test_a_lone_attractors_loop_stops_at_the_step_that_fails_and_keeps_the_last_
     assert sim.pos[1, 0] == pytest.approx(17e307, rel=1e-15) and sim.pos[1, 1] == 2.0
 
 
+@pytest.mark.parametrize("dt, done", [(1.0, 17), (0.125, 143)])
+def test_a_mutual_gravity_loop_stops_at_the_step_that_fails_and_keeps_the_last_finite_state(
+        dt, done):
+    """The loop of mutual gravity alone saves its state every ``CHECKPOINT_STEPS`` (64) steps
+    and, when a step fails, takes the steps since the last save again to find the state that
+    step began from. A massless body at 1e307 per unit time (G = 0, so its drift is a straight
+    line and nothing else overflows) passes the largest float (1.8e308) half a step after
+    t = 17.5: with dt = 1 that is step 18 (found from the first save), with dt = 1/8 step 144
+    (found from the save at step 128, fifteen steps taken again). The steps before it count,
+    the body is named, and the state kept is theirs: the runaway body at 1e307 t exactly
+    (one step more or less would be off by 1e307 dt), the other two as a clean run's."""
+    def scene(runaway):
+        sim = Simulation(dim=2, integrator="whfast", dt=dt)
+        sim.add(mass=1.0, pos=(0.0, 0.0))
+        sim.add(mass=1e-3, pos=(1.0, 0.0), vel=(0.0, 1.0))
+        if runaway:
+            sim.add(mass=0.0, pos=(0.0, 2.0), vel=(1e307, 0.0))
+        sim.add_force(forces.NBodyGravity(G=0.0))
+        return sim
+    sim = scene(True)
+    with pytest.raises(engine.SimulationError) as info:
+        sim.step(400)
+    assert (info.value.step, info.value.particle, sim.steps) == (done, 2, done)
+    assert sim.t == done * dt
+    assert np.all(np.isfinite(sim.pos)) and np.all(np.isfinite(sim.vel))
+    assert sim.pos[2, 0] == pytest.approx(1e307 * (done * dt), rel=1e-13)
+    clean = scene(False)
+    clean.step(done)
+    np.testing.assert_allclose(sim.pos[:2], clean.pos, rtol=0, atol=1e-14)
+    np.testing.assert_array_equal(sim.vel[:2], clean.vel)
+
+
 def test_a_drift_that_overflows_raises_instead_of_hanging():
     """A massless body at 1e150 per unit time, stepped by 1e157: its Kepler drift's z = beta X^2
     overflows to infinity, which the Stumpff functions' quartering loop used to quarter for
