@@ -59,7 +59,9 @@ of the step are read off the polynomial, and its timescale is
 
     tau_i^2 = 2 |a|^2 / (|j|^2 + |a| |k|)
 
-(particles whose acceleration at the start of the step is zero or not normal are skipped). The
+(particles whose acceleration at the start of the step is zero or not normal are skipped, and
+so are those whose acceleration at the start is below 1e-12 of the one at the end: zero but
+for round-off, see ``_timescale2``). The
 next step is ``dt_new = (7! epsilon)^(1/7) min_i tau_i``; if no particle gives a timescale the
 step grows by 4. A step whose ``dt_new`` is less than a quarter of the step just tried is
 rejected and retried with ``dt_new``; otherwise ``dt_new`` is used next, growing by at most a
@@ -164,6 +166,9 @@ _NO_PREDICTION = 20.0   # beyond this ratio of steps the predictor is dropped (b
 _FACTORIAL7 = 5040.0
 _EPS = 2.220446049250313e-16
 _MIN_NORMAL = 2.2250738585072014e-308
+#: (1e-12)^2: a particle whose acceleration at the start of a step is below 1e-12 of the one at
+#: its end started the step at a zero of its acceleration (``_timescale2``)
+_ZERO_START2 = 1e-24
 
 # -- the caller-owned memory ---------------------------------------------------------------------
 #: header entries of ``memory`` (then the blocks listed in ``memory_shape``)
@@ -377,6 +382,41 @@ def _horner(b, weights, s, w, m):
             w[c] = w[c] * s + b[j, c] * f
 
 
+@njit(cache=True, error_model="numpy", fastmath={"reassoc"})
+def _moving_finite(acc, mask, m):
+    """True if the acceleration of every moving component is finite: x * 0 is 0 for finite x
+    and NaN for inf or NaN, and a sum of zeros never overflows. Compiled on its own with
+    reassociation allowed (and only that: no assumption about NaN or infinity), so the sum
+    runs four components an instruction; a branch per component, as before, cost about 0.6 us
+    of a 5.2 us step of the outer solar system (22 nodes a step)."""
+    s = 0.0
+    for c in range(m):
+        s += (acc[c] if mask[c] != 0.0 else 0.0) * 0.0
+    return s == 0.0
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _positions_at(b, s, sdt, x0, v0, a0, csx, sx, m):
+    """The positions at node ``s`` (``sdt`` = s dt) from the current b: ``_horner`` with
+    ``_XINV`` and the position update in one pass over the components, the polynomial
+    written out, without the scratch row in between (the same operations in the same order;
+    the compiler fuses some multiply-adds differently, so the round-off differs: final states
+    of the outer solar system, the Pythagorean and a Kepler problem within 5e-15 of the
+    previous form's, with the same steps). With ``_moving_finite`` a step of the outer solar
+    system went from 5.2 to 4.8 us (5.2 to 4.9 us without this)."""
+    x0_, x1, x2, x3, x4, x5, x6 = _XINV[0], _XINV[1], _XINV[2], _XINV[3], _XINV[4], _XINV[5], \
+        _XINV[6]
+    for c in range(m):
+        p = b[6, c] * x6
+        p = p * s + b[5, c] * x5
+        p = p * s + b[4, c] * x4
+        p = p * s + b[3, c] * x3
+        p = p * s + b[2, c] * x2
+        p = p * s + b[1, c] * x1
+        p = p * s + b[0, c] * x0_
+        sx[c] = x0[c] + (sdt * (v0[c] + sdt * (p * s + 0.5 * a0[c])) - csx[c])
+
+
 @njit(cache=True, error_model="numpy", inline="always")
 def _iterate(t, dt, state, model, work, vdep, mask, a0, v0, x0, u0, b, csx, csv, g, csb, acc,
              sx, sv, w, change, fused):
@@ -440,9 +480,7 @@ def _iterate(t, dt, state, model, work, vdep, mask, a0, v0, x0, u0, b, csx, csv,
             s = _H[node]
             sdt = s * dt
             # positions (and velocities) at the node from the current b
-            _horner(b, _XINV, s, w, m)
-            for c in range(m):
-                sx[c] = x0[c] + (sdt * (v0[c] + sdt * (w[c] * s + 0.5 * a0[c])) - csx[c])
+            _positions_at(b, s, sdt, x0, v0, a0, csx, sx, m)
             if vdep:
                 _horner(b, _VINV, s, w, m)
                 for c in range(m):
@@ -470,13 +508,12 @@ def _iterate(t, dt, state, model, work, vdep, mask, a0, v0, x0, u0, b, csx, csv,
                     total = b[j, c] + y
                     csb[j, c] = (total - b[j, c]) - y
                     b[j, c] = total
-            for c in range(m):
-                if mask[c] != 0.0 and not math.isfinite(acc[c]):
-                    for i in range(n):
-                        if mask[i] != 0.0:
-                            for k in range(dim):
-                                if not math.isfinite(acc2d[k, i]):
-                                    return i, iterations, evaluations
+            if not _moving_finite(acc, mask, m):
+                for i in range(n):
+                    if mask[i] != 0.0:
+                        for k in range(dim):
+                            if not math.isfinite(acc2d[k, i]):
+                                return i, iterations, evaluations
             if node == 7:
                 max_a = 0.0
                 max_db = 0.0
@@ -542,6 +579,13 @@ def _timescale2(a0, b, mask, n):
             snap2 += snap * snap
         if not (start >= _MIN_NORMAL and start < math.inf):
             continue  # no acceleration (or an unusable one) at the start of the step
+        if start < _ZERO_START2 * acc2:
+            # an acceleration at the start that is zero but for round-off (a body at the
+            # centre of a symmetric configuration, the figure-eight's at t = 0, whose forces
+            # cancel to within the rounding of a fused multiply-add): skipped as an exact zero
+            # is. Counted, it gives tau = sqrt(2) |a_end| / |jerk| = sqrt(2) dt whatever the
+            # step, every attempt asks for a quarter of itself, and the step collapses
+            continue
         tau2 = 2.0 * acc2 / (jerk2 + math.sqrt(snap2 * acc2))
         if tau2 >= _MIN_NORMAL and tau2 < best:
             best = tau2
