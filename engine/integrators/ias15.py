@@ -334,8 +334,11 @@ def _forces(t, state, model, acc, work, fused):
     f0 = model.param_offsets[0]
     G = model.params[f0]
     eps2 = model.params[f0 + 1]
-    for k in range(dim):
-        for i in range(n):
+    for i in range(n):
+        # zeroed body by body, as the loop below reads them: zeroed a row at a time, the
+        # stores became vector stores, and the scalar loads of the pair loop waited on them
+        # (80 -> 66 ns for the outer solar system's 15 pairs, measured in a loop of calls)
+        for k in range(dim):
             acc[k, i] = 0.0
     for i in range(n):
         if not active[i]:

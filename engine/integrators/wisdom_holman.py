@@ -741,8 +741,8 @@ def _gravity_step(jp, jv, mo, count, massive, eta, mu, G, xs, ad, ja, kw, kick, 
     """One step of ``_gravity_steps``: the interaction's kick, then the drift ``d``."""
     dim = jp.shape[0]
     _gravity_interaction(jp, mo, count, massive, eta, mu, G, xs, ad, ja, kw)
-    for j in range(count):
-        for k in range(dim):
+    for k in range(dim):  # by rows: 258-263 -> 247-254 ns a step, against by columns
+        for j in range(count):
             jv[k, j] += kick * ja[k, j]
     for k in range(dim):
         jp[k, 0] += d * jv[k, 0]
