@@ -207,13 +207,8 @@ def _start(jp, jv, j, mu, dt, kw, known):
     """Column j's invariants and the start of X into ``kw``, as ``drift_column`` starts
     (``_start_of_x``; whole periods of a long elliptic arc dropped from ``kw[_DT]``);
     ``known``: r0 and 1 / r0 are in ``kw[_R0]`` and ``kw[_INV]`` already."""
-    if known:
-        dim = jp.shape[0]
-        vx = jv[0, j]
-        vy = jv[1, j]
-        vz = jv[2, j] if dim == 3 else 0.0
-        v2 = vx * vx + vy * vy + vz * vz
-        eta0 = jp[0, j] * vx + jp[1, j] * vy + (jp[2, j] * vz if dim == 3 else 0.0)
+    if known:  # r0 left unused here, so its square root is not computed
+        _, _, _, _, _, _, _, v2, eta0 = _column(jp, jv, j)
         r0 = kw[_R0, j]
         inv = kw[_INV, j]
     else:

@@ -707,22 +707,6 @@ def advance(t, h, steps, state, kick_model, work, vdep, t_end, mode, order, m, G
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _columns_finite(jp, jv, count):
-    """``all_finite`` for the step loops' columns: x * 0 is 0 for finite x and NaN for inf or
-    NaN; a column's six products are added as a tree and the columns' sums in one chain, so
-    the check waits on ``count`` additions, not ``6 count`` (a chain of dependent additions
-    is what a check of 36 numbers costs)."""
-    dim = jp.shape[0]
-    s = 0.0
-    for j in range(count):
-        a = jp[0, j] * 0.0 + jv[0, j] * 0.0
-        b = jp[1, j] * 0.0 + jv[1, j] * 0.0
-        c = jp[2, j] * 0.0 + jv[2, j] * 0.0 if dim == 3 else 0.0
-        s += (a + b) + c
-    return s == 0.0
-
-
-@njit(cache=True, error_model="numpy", inline="always")
 def _save_columns(jp, jv, save_p, save_v, count):
     """The coordinates a step starts from, kept: a step that fails is undone from them."""
     for j in range(count):
@@ -776,7 +760,7 @@ def _gravity_steps(t, h, steps, jp, jv, save_p, save_v, mo, count, massive, eta,
         d = last if step == steps - 1 else merged
         _gravity_step(jp, jv, mo, count, massive, eta, mu, G, xs, ad, ja, kw, kick, d)
         since += 1
-        if not _columns_finite(jp, jv, count):
+        if not all_finite(jp, jv, count):
             bad = _first_bad_column(jp, jv, count)
             _save_columns(save_p, save_v, jp, jv, count)
             for _ in range(since - 1):  # the steps before the failing one: none was the last
@@ -804,7 +788,7 @@ def _free_steps(t, h, steps, jp, jv, save_p, save_v, count, mu, kw, merged, last
         _kepler_drift(ATTRACTOR, jp, jv, mu, count, last if step == steps - 1 else merged, kw,
                       box)
         since += 1
-        if not _columns_finite(jp, jv, count):
+        if not all_finite(jp, jv, count):
             bad = _first_bad_column(jp, jv, count)
             _save_columns(save_p, save_v, jp, jv, count)
             for _ in range(since - 1):
