@@ -15,7 +15,10 @@ every frame until the last one ends: the row of a finished match keeps its last 
 and its action is ignored. A batch bot from a file plays so in its own confined process
 (``spacewar.seats.BatchProcessSeat``) when its class defines ``act_batch`` in its body
 (``spacewar.bots.declares_act_batch``). Played one match at a time (``spacewar match``), it
-is called with K = 1.
+is called with K = 1; ``spacewar check`` plays it as a tournament does, K matches at once
+(``spacewar.checker``). Over the wire its process answers each call with exactly K codes
+and status OK, or with no code and another status; any other count is a breach of the
+protocol (``spacewar.wire``), which forfeits all its live matches.
 
 A NumPy or PyTorch policy so plays hundreds of matches in one forward pass.
 """

@@ -27,6 +27,7 @@ live matches' allowances together) or breaks the wire protocol forfeits all of i
 matches, each recording why; its output is in each of its matches' results. A match whose
 seat forfeits stops where it is (as a match alone stops), while the others play on.
 """
+import array
 import time
 
 import numpy as np
@@ -37,10 +38,10 @@ from .bots import declares_act_batch, is_builtin, is_policy_file
 from .game import Game
 from .learning import learning_length
 from .match import (DEFAULT_BUDGET, DEFAULT_MAX_FAULTS, FaultLog, _cpu_seconds, _result,
-                    bot_seed, checked_limits)
+                    act_time_summary, bot_seed, checked_limits)
 from .protocol import raw_length
 from .rules import Rules, count_at_least
-from .seats import _KIND_BY_STATUS, BatchProcessSeat, _Bank, bot_name, open_seat
+from .seats import _KIND_BY_STATUS, FAULT_KINDS, BatchProcessSeat, _Bank, bot_name, open_seat
 from .wire import INVALID, MAX_ROWS, OK, exception_text
 
 
@@ -81,6 +82,8 @@ class _BatchSide:
         self.dead = None
         self.bot = spec
         self.seat = None
+        # each row's charged share of every call (``spacewar.seats``' ``act_seconds``)
+        self.act_seconds = [array.array("d") for _ in rows]
         if seat_options is not None:  # untrusted: its own process
             self.bot = None
             self.seat = BatchProcessSeat(spec, rules=rules, rows=len(rows), **seat_options)
@@ -107,11 +110,18 @@ class _BatchSide:
 
 
 def play_matches(matches, rounds=5, rules=None, budget=DEFAULT_BUDGET,
-                 max_faults=DEFAULT_MAX_FAULTS, limits=None, batch_files=None):
+                 max_faults=DEFAULT_MAX_FAULTS, limits=None, batch_files=None, record=False,
+                 act_seconds=False):
     """Play ``matches`` (a list of ``(p1, p2, seed)``) together; return a list of
     ``(result, timing)``, one per match in order, ``result`` as ``play_match`` gives it.
     ``batch_files``: the bots from files to play as batch bots (default: those whose class
-    defines ``act_batch``, ``spacewar.bots.declares_act_batch``)."""
+    defines ``act_batch``, ``spacewar.bots.declares_act_batch``).
+
+    ``timing`` holds ``wall_seconds`` (the game's, shared equally), ``frames_per_second``,
+    ``act`` (per seat, ``act_time_summary`` of the times charged to that match: a batch
+    bot's share of each call) and, with ``act_seconds``, every one of those times per seat.
+    With ``record`` each entry is ``(result, replay, timing)``, the replay each match's as
+    ``play_match`` records it."""
     rules = Rules() if rules is None else rules
     matches = [tuple(x) for x in matches]
     if not matches:
@@ -138,8 +148,9 @@ def play_matches(matches, rounds=5, rules=None, budget=DEFAULT_BUDGET,
     forfeits = np.zeros((count, 2), dtype=bool)
     banks = [[_Bank(limits), _Bank(limits)] for _ in range(count)]
     sides, seats = _open(matches, limits, rules, rounds, batch_files)
+    tape = _Tape(count) if record else None
     try:
-        wall = _play(game, sides, seats, faults, forfeits, banks, max_faults)
+        wall = _play(game, sides, seats, faults, forfeits, banks, max_faults, tape)
     finally:
         outputs = [[None, None] for _ in range(count)]
         for m, row in enumerate(seats):
@@ -154,13 +165,82 @@ def play_matches(matches, rounds=5, rules=None, budget=DEFAULT_BUDGET,
     for m, (p1, p2, seed) in enumerate(matches):
         result = _result(game, (bot_name(p1), bot_name(p2)), seed, rounds, rules, faults[m],
                          forfeits[m].tolist(), outputs[m], m=m)
-        out.append((result, {"wall_seconds": wall / count,
-                             "frames_per_second": result["steps"] / max(wall / count, 1e-9)}))
+        times = _act_times(m, sides, seats)
+        timing = {"wall_seconds": wall / count,
+                  "frames_per_second": result["steps"] / max(wall / count, 1e-9),
+                  "act": [act_time_summary(t) for t in times]}
+        if act_seconds:
+            timing["act_seconds"] = times
+        if record:
+            out.append((result, tape.replay(game, m, result, max_faults), timing))
+        else:
+            out.append((result, timing))
     return out
 
 
-def _play(game, sides, seats, faults, forfeits, banks, max_faults):
-    """Play every match to its end or its forfeit; return the wall-clock seconds."""
+def _act_times(m, sides, seats):
+    """Per seat of match ``m``, the float64 array of the times charged to it."""
+    times = [None, None]
+    for s, seat in enumerate(seats[m]):
+        if seat is not None:
+            times[s] = seat.act_seconds
+    for side in sides:
+        for k, (row_m, s) in enumerate(side.rows):
+            if row_m == m:
+                times[s] = side.act_seconds[k]
+    return [np.frombuffer(t, dtype=np.float64).copy() for t in times]
+
+
+class _Tape:
+    """What ``play_match`` records of each match, kept for all of them: two action codes
+    per frame played, and two fault-kind codes (0 none, 1 + ``FAULT_KINDS`` index) per frame
+    asked, the frame a match forfeits on included."""
+
+    def __init__(self, count):
+        self.actions = [bytearray() for _ in range(count)]
+        self.faults = [bytearray() for _ in range(count)]
+        self._before = None
+
+    def asking(self, faults, live):
+        """Before a frame's questions: each live match's fault counts, to see what is new."""
+        self._before = {int(m): (faults[m][0].total, faults[m][1].total)
+                        for m in np.flatnonzero(live)}
+
+    def asked(self, faults, forfeits, actions):
+        """After them: each live match's new faults, and its actions when it plays the frame."""
+        for m, totals in self._before.items():
+            kinds = [0, 0]
+            for s in range(2):
+                if faults[m][s].total > totals[s]:  # one question a frame: at most one fault
+                    kinds[s] = 1 + FAULT_KINDS.index(faults[m][s].last["kind"])
+            self.faults[m] += bytes(kinds)
+            if not forfeits[m].any():
+                self.actions[m] += bytes((int(actions[m, 0]), int(actions[m, 1])))
+
+    def replay(self, game, m, result, max_faults):
+        from .replay import make_replay
+
+        return make_replay(result, bytes(self.actions[m]), _final_hash(game, m, result),
+                           faults=bytes(self.faults[m]), max_faults=max_faults)
+
+
+def _final_hash(game, m, result):
+    """Match ``m``'s final state hash as ``play_match`` (and a replay's check) sees it: a
+    match that stopped on a forfeit was marked over here only to be stepped no more, while
+    a match alone just stops, live (a forfeit happens only to a live match)."""
+    if not any(result["forfeits"]):
+        return game.state_hash(m)
+    match_state = game.match_state
+    match_state[m, core.OVER] = 0
+    try:
+        return game.state_hash(m)
+    finally:
+        match_state[m, core.OVER] = 1
+
+
+def _play(game, sides, seats, faults, forfeits, banks, max_faults, tape=None):
+    """Play every match to its end or its forfeit; return the wall-clock seconds. ``tape``
+    (a ``_Tape``) records what each match's replay needs."""
     count = len(seats)
     for side in sides:
         if side.wait_ready() is not None:
@@ -186,6 +266,8 @@ def _play(game, sides, seats, faults, forfeits, banks, max_faults):
     while live.any():
         if learning is not None:
             game.learning_observations(learning)
+        if tape is not None:
+            tape.asking(faults, live)
         for side in sides:
             _ask_side(side, call, learning, live, match_state, actions, faults, banks, forfeits)
         call += 1
@@ -203,6 +285,8 @@ def _play(game, sides, seats, faults, forfeits, banks, max_faults):
                     forfeits[m, s] = True
             if forfeits[m].any():
                 match_state[m, core.OVER] = 1
+        if tape is not None:
+            tape.asked(faults, forfeits, actions)
         game._step_codes(actions)  # codes from the checks above: valid
         live = match_state[:, core.OVER] == 0
     return time.perf_counter() - start
@@ -268,6 +352,8 @@ def _ask_side(side, call, learning, live, match_state, actions, faults, banks, f
             continue
         frame = int(match_state[m, core.FRAME])
         actions[m, s] = core.NOOP
+        if share is not None:
+            side.act_seconds[k].append(share)
         if fault is not None:  # its process gave no answer
             faults[m][s].add(frame, *fault)
             if side.dead is not None:

@@ -17,7 +17,7 @@ import os
 import sys
 
 from . import wire
-from .protocol import observation_from_raw
+from .protocol import observation_of_copy, raw_length
 
 
 def _read_exact(fd, n):
@@ -29,6 +29,34 @@ def _read_exact(fd, n):
         chunks.append(chunk)
         n -= len(chunk)
     return b"".join(chunks)
+
+
+class _Inbox:
+    """The match's messages as they arrive: each read takes whatever the pipe holds (a whole
+    observation: the match writes one in a single piece before it lets this process run),
+    and the parts a message is parsed from are served from that. One system call a message
+    where reading header and body apart took two."""
+
+    def __init__(self, fd):
+        self.fd = fd
+        self.data = b""  # what was read and not yet served: data[position:]
+        self.position = 0
+
+    def read_exact(self, n):
+        end = self.position + n
+        if end > len(self.data):
+            parts = [self.data[self.position:]]
+            missing = end - len(self.data)
+            while missing > 0:
+                chunk = os.read(self.fd, max(missing, 1 << 16))
+                if not chunk:
+                    raise EOFError
+                parts.append(chunk)
+                missing -= len(chunk)
+            self.data, self.position, end = b"".join(parts), 0, n
+        part = self.data[self.position:end]
+        self.position = end
+        return part
 
 
 def _write_all(fd, data):
@@ -88,8 +116,11 @@ def _load(config):
 
 
 def _answer(bot, rules, frame, raw):
-    """The answer message of ``bot`` to the observation ``raw`` of ``frame``."""
-    status, code, text = wire.ask(bot, observation_from_raw(raw, rules))
+    """The answer message of ``bot`` to the observation ``raw`` of ``frame`` (a fresh array
+    of this process's own, which the observation keeps)."""
+    if raw.shape != (raw_length(rules),):
+        raise wire.WireError(f"observation of {raw.size} numbers, {raw_length(rules)} expected")
+    status, code, text = wire.ask(bot, observation_of_copy(raw, rules))
     return wire.pack_answer(frame, status, code, text)
 
 
@@ -131,9 +162,10 @@ def main(argv):
     _write_all(fd_out, wire.pack_answer(-1, wire.READY, 0, "; ".join(layers)))
     batch = bool(config.get("batch"))
     read = wire.read_batch if batch else wire.read_observe
+    read_exact = _Inbox(fd_in).read_exact
     while True:
         try:
-            message = read(lambda n: _read_exact(fd_in, n))
+            message = read(read_exact)
         except (EOFError, OSError, ValueError):
             break
         if message is None:
@@ -144,6 +176,8 @@ def main(argv):
                 answer = _answer_batch(bot, frame, observation)
             else:
                 answer = _answer(bot, rules, frame, observation)
+        except wire.WireError:
+            break
         except MemoryError:
             answer = (wire.pack_codes(frame, wire.MEMORY, b"", "MemoryError") if batch
                       else wire.pack_answer(frame, wire.MEMORY, 0, "MemoryError"))

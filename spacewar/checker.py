@@ -13,6 +13,9 @@ seats, and reports
 * whether it is deterministic: the first match is played again with the same seed, and the
   two plays' results and replays (every frame's actions and faults, the final state's
   SHA-256) must be identical;
+* for a batch bot named by a file, all of that as a tournament plays it: each opponent's
+  matches in one game, its one confined process answering for all of them at once
+  (``check_bot``), so that what it does in a tournament is what is checked;
 * how each match went (wins, draws, losses: for information, never a reason to fail).
 
 It passes when it loads, has no fault and no forfeit, its p99 action time is within the
@@ -31,12 +34,15 @@ import numpy as np
 from .bots import BotLoadError, available, locate
 from .match import DEFAULT_MAX_FAULTS, _check_bot_argument, act_time_summary, play_match
 from .rules import Rules, count_at_least
-from .seats import FAULT_KINDS, Limits, bot_name
+from .seats import FAULT_KINDS, Limits, bot_name, printable
 
 #: a p99 action time above this fraction of the budget is a warning (little headroom)
 HEADROOM = 0.5
 #: fault messages kept in a report
 MAX_EXAMPLES = 5
+#: ``spacewar tournament``'s default seeds a pairing: a batch bot's default here, so that it
+#: is asked for as many matches at once (2 x 10) as in a tournament of the defaults
+TOURNAMENT_GAMES = 10
 
 
 @dataclasses.dataclass
@@ -55,7 +61,9 @@ class CheckReport:
     seconds. ``deterministic``: True, False, or None when not checked (the bot could not
     start); ``determinism``: what was compared and what differed. ``output_bytes``: how many
     bytes it printed in all (a confined bot's stdout and stderr are captured). ``settings``:
-    what the check played with (opponents, games, seed, rounds, rules, budgets)."""
+    what the check played with (opponents, games, seed, rounds, rules, budgets, and
+    ``together``: the size of each group of matches played at once, as a tournament plays a
+    batch bot's matches, empty when every match was played alone)."""
 
     bot: str
     passed: bool = False
@@ -79,13 +87,18 @@ class CheckReport:
         return dataclasses.asdict(self)
 
     def format(self):
-        """The report as text for a terminal: the verdict first, then the details."""
+        """The report as text for a terminal: the verdict first, then the details; every line
+        escaped (``seats.printable``): the bot's name is a file name, its messages its own."""
         lines = [f"{'PASS' if self.passed else 'FAIL'}: {self.bot}"]
         lines += [f"  reason: {r}" for r in self.reasons]
         lines += [f"  warning: {w}" for w in self.warnings]
         if self.load_error is not None:  # the reason says it all: nothing was played
-            return "\n".join(lines)
+            return "\n".join(printable(line) for line in lines)
         lines.append(f"  matches: {_tally(self.matches)}")
+        if self.settings.get("together"):
+            sizes = "/".join(str(k) for k in sorted(set(self.settings["together"])))
+            lines.append(f"  played as a tournament plays it: {sizes} matches at once "
+                         "against each opponent, in one game")
         for opponent, text in _per_opponent(self.matches):
             lines.append(f"    vs {opponent:<10}{text}")
         total = sum(self.faults.values())
@@ -98,10 +111,10 @@ class CheckReport:
         lines.append(f"  deterministic: {_yes_no(self.deterministic)}: {self.determinism}")
         if self.output_bytes:
             lines.append(f"  printed output: {self.output_bytes} bytes (captured, not shown)")
-        return "\n".join(lines)
+        return "\n".join(printable(line) for line in lines)
 
 
-def check_bot(bot, *, opponents=None, games=1, seed=0, rounds=1, rules=None, limits=None,
+def check_bot(bot, *, opponents=None, games=None, seed=0, rounds=1, rules=None, limits=None,
               max_faults=DEFAULT_MAX_FAULTS, isolation="auto", on_match=None):
     """Check the bot ``bot`` (a specification, as ``spacewar match`` takes it, or a bot
     object, which plays in this process) and return a ``CheckReport``.
@@ -109,11 +122,21 @@ def check_bot(bot, *, opponents=None, games=1, seed=0, rounds=1, rules=None, lim
     It plays ``games`` seeds (``seed``, ``seed + 1``, ...) against each of ``opponents``
     (default every built-in bot) from both seats, each match of ``rounds`` rounds under
     ``rules`` and ``limits`` (a ``spacewar.seats.Limits``; default the match defaults), then
-    the first match once more to compare. ``on_match(record)`` is called after each match
-    with its ``CheckReport.matches`` entry (``"repeat": True`` on the determinism replay).
-    Bad arguments raise ValueError or TypeError naming them before any match is played."""
-    opponents, rules, limits = _checked_arguments(bot, opponents, games, seed, rounds, rules,
-                                                  limits, max_faults, isolation)
+    the first match once more to compare. The matches are grouped as a tournament groups
+    its own (``spacewar.tournament``): a bot named by a file that plays as a batch bot (or a
+    policy file) plays each opponent's ``2 * games`` matches together, answering for all of
+    them at once, so it cannot tell a check from a tournament by its batch size; its
+    ``games`` default to a tournament's (``TOURNAMENT_GAMES``), every other bot's to 1, and
+    the determinism replay plays that first group again. ``on_match(record)`` is called
+    after each match with its ``CheckReport.matches`` entry (``"repeat": True`` on the
+    determinism replay). Bad arguments raise ValueError or TypeError naming them before any
+    match is played."""
+    opponents, rules, limits = _checked_arguments(bot, opponents, 1 if games is None else games,
+                                                  seed, rounds, rules, limits, max_faults,
+                                                  isolation)
+    batch_files = _batch_files(bot, opponents)
+    if games is None:
+        games = TOURNAMENT_GAMES if _plays_together(bot, batch_files, isolation) else 1
     report = CheckReport(bot=bot_name(bot), budget=limits.budget, settings={
         "opponents": list(opponents), "games": int(games), "seed": int(seed),
         "rounds": int(rounds), "rules": rules.to_dict(), "max_faults": int(max_faults),
@@ -124,19 +147,23 @@ def check_bot(bot, *, opponents=None, games=1, seed=0, rounds=1, rules=None, lim
             locate(bot)  # a name that cannot be a bot fails here, before any process starts
         except BotLoadError as exc:
             return _failed_to_load(report, str(exc))
+    jobs = _jobs(bot, opponents, games, seed, isolation, batch_files)
+    report.settings["together"] = [len(entries) for entries, together in jobs if together]
     play = dict(rounds=rounds, rules=rules, limits=limits, max_faults=max_faults,
-                isolation=isolation, act_seconds=True)
+                isolation=isolation, batch_files=batch_files)
     times, first = [], None
-    for opponent, game_seed, seat in _schedule(opponents, games, seed):
-        result, replay, timing = play_match(*_seated(bot, opponent, seat), seed=game_seed,
-                                            record=first is None, **play)
-        startup = _startup_fault(result, seat)
-        if startup is not None:
-            return _failed_to_load(report, startup)
+    for entries, together in jobs:
+        played = _play_job(bot, entries, together, play, record=first is None)
+        for k, ((opponent, game_seed, seat), (result, _, timing)) in enumerate(zip(entries,
+                                                                                 played)):
+            startup = _startup_fault(result, seat)
+            if startup is not None:
+                return _failed_to_load(report, startup)
+            times.append(timing["act_seconds"][seat])
+            # matches played together share one process, whose output each of them shows
+            _add_match(report, opponent, game_seed, seat, result, on_match, output=k == 0)
         if first is None:
-            first = (opponent, game_seed, seat, result, replay)
-        times.append(timing["act_seconds"][seat])
-        _add_match(report, opponent, game_seed, seat, result, on_match)
+            first = (entries, together, played)
     _judge_determinism(report, bot, first, play, on_match)
     pooled = np.concatenate(times)
     report.act = act_time_summary(pooled)
@@ -180,6 +207,59 @@ def _schedule(opponents, games, seed):
             for seat in (0, 1)]
 
 
+def _batch_files(bot, opponents):
+    """The bots from files among ``bot`` and ``opponents`` that a tournament plays as batch
+    bots (``tournament.batch_files_of``); none are run to find out."""
+    from .tournament import batch_files_of
+
+    return batch_files_of([x for x in [bot, *opponents] if isinstance(x, str)])
+
+
+def _plays_together(bot, batch_files, isolation):
+    """Whether a tournament plays ``bot``'s matches against a built-in bot together: a
+    specification of a batch bot or a policy file (``batch_match.is_batch_spec``), unless
+    every match is confined alone (``isolation="process"``). A bot object is the caller's own
+    code, which no tournament plays: it plays its matches one at a time."""
+    from .batch_match import is_batch_spec
+
+    return isinstance(bot, str) and isolation != "process" and is_batch_spec(bot, batch_files)
+
+
+def _jobs(bot, opponents, games, seed, isolation, batch_files):
+    """The schedule cut as a tournament cuts its own (``tournament._jobs``): a list of
+    ``(entries, together)``, ``entries`` the ``(opponent, seed, seat)`` of each match of a
+    job, ``together`` whether they are played in one game (``batch_match.play_matches``)."""
+    from .tournament import _jobs as tournament_jobs
+
+    schedule = _schedule(opponents, games, seed)
+    if not isinstance(bot, str):
+        return [([entry], False) for entry in schedule]
+    matches = [(*_seated(bot, opponent, seat), s) for opponent, s, seat in schedule]
+    jobs, start = [], 0
+    for job, together in tournament_jobs(matches, isolation, batch_files):
+        jobs.append((schedule[start:start + len(job)], together))
+        start += len(job)
+    return jobs
+
+
+def _play_job(bot, entries, together, play, record):
+    """``[(result, replay, timing)]`` of a job's matches (``replay`` None unless ``record``),
+    ``timing`` with every action's time (``act_seconds``)."""
+    options = dict(play)
+    batch_files = options.pop("batch_files")
+    if not together:
+        (opponent, game_seed, seat), = entries
+        return [play_match(*_seated(bot, opponent, seat), seed=game_seed, record=record,
+                           act_seconds=True, **options)]
+    from .batch_match import play_matches
+
+    options.pop("isolation")  # together only when it is not "process"
+    matches = [(*_seated(bot, opponent, seat), s) for opponent, s, seat in entries]
+    played = play_matches(matches, batch_files=batch_files, record=record, act_seconds=True,
+                          **options)
+    return played if record else [(result, None, timing) for result, timing in played]
+
+
 def _seated(bot, opponent, seat):
     """``(p1, p2)`` with the checked bot in ``seat``."""
     return (bot, opponent) if seat == 0 else (opponent, bot)
@@ -207,8 +287,8 @@ def _outcome(result, seat):
     return "win" if result["winner_seat"] == seat else "loss"
 
 
-def _add_match(report, opponent, game_seed, seat, result, on_match):
-    """Count one match's outcome, faults, forfeit and output into ``report``."""
+def _add_match(report, opponent, game_seed, seat, result, on_match, output=True):
+    """Count one match's outcome, faults, forfeit and (``output``) output into ``report``."""
     faults = result["faults"][seat]
     record = {"opponent": opponent, "seat": seat, "seed": game_seed,
               "outcome": _outcome(result, seat),
@@ -224,7 +304,8 @@ def _add_match(report, opponent, game_seed, seat, result, on_match):
             report.fault_examples.append({**example, "opponent": opponent, "seat": seat,
                                           "seed": game_seed})
     report.forfeits += record["forfeited"]
-    report.output_bytes += result["output"][seat]["bytes"]
+    if output:
+        report.output_bytes += result["output"][seat]["bytes"]
     if on_match is not None:
         on_match(record)
 
@@ -240,33 +321,76 @@ def play_fingerprint(result, replay):
     return hashlib.sha256(text.encode("utf-8")).hexdigest()
 
 
+@dataclasses.dataclass
+class _TwoPlays:
+    """One match of the determinism replay: the checked bot's seat, the seed, and the two
+    plays' results and replays."""
+
+    seat: int
+    seed: int
+    result: dict
+    replay: dict
+    again: dict
+    replay_again: dict
+
+    def differ(self):
+        return (play_fingerprint(self.result, self.replay)
+                != play_fingerprint(self.again, self.replay_again))
+
+    def output_differs(self):
+        return self.result["output"][self.seat] != self.again["output"][self.seat]
+
+    def was_late(self):
+        return bool(self.result["faults"][self.seat]["timeout"]
+                    or self.again["faults"][self.seat]["timeout"])
+
+
 def _judge_determinism(report, bot, first, play, on_match):
-    """Play the first match again and compare the two plays (``play_fingerprint``)."""
-    opponent, game_seed, seat, result, replay = first
-    again, replay_again, _ = play_match(*_seated(bot, opponent, seat), seed=game_seed,
-                                        record=True, **play)
-    if on_match is not None:
-        on_match({"opponent": opponent, "seat": seat, "seed": game_seed, "repeat": True,
-                  "outcome": _outcome(again, seat),
-                  "score": [again["score"][seat], again["score"][1 - seat]]})
-    where = f"seed {game_seed} against {opponent} from seat {seat + 1}, played twice"
-    one, two = play_fingerprint(result, replay), play_fingerprint(again, replay_again)
-    if one == two:
+    """Play the first job again (one match, or a batch bot's first group of matches) and
+    compare the two plays of each match (``play_fingerprint``)."""
+    entries, together, played = first
+    replayed = _play_job(bot, entries, together, play, record=True)
+    pairs = []
+    for (opponent, game_seed, seat), (result, replay, _), (again, replay_again, _) in zip(
+            entries, played, replayed):
+        if on_match is not None:
+            on_match({"opponent": opponent, "seat": seat, "seed": game_seed, "repeat": True,
+                      "outcome": _outcome(again, seat),
+                      "score": [again["score"][seat], again["score"][1 - seat]]})
+        pairs.append(_TwoPlays(seat, game_seed, result, replay, again, replay_again))
+    where = _replayed_where(entries)
+    differing = [pair for pair in pairs if pair.differ()]
+    if not differing:
         report.deterministic = True
-        report.determinism = f"{where}: identical (play fingerprint {one[:16]})"
-        if result["output"][seat] != again["output"][seat]:
+        fingerprint = play_fingerprint(pairs[0].result, pairs[0].replay)
+        report.determinism = f"{where}: identical (play fingerprint {fingerprint[:16]})"
+        if any(pair.output_differs() for pair in pairs):
             report.warnings.append("what it prints differs between two plays of the same "
                                    "match, so their result JSON differs (the play is the same)")
         return
+    pair = differing[0]
     report.deterministic = False
-    report.determinism = f"{where}: {_first_difference(replay, replay_again, seat)}"
-    if result["faults"][seat]["timeout"] or again["faults"][seat]["timeout"]:
+    difference = _first_difference(pair.replay, pair.replay_again, pair.seat)
+    if len(entries) > 1:
+        difference = f"seed {pair.seed} from seat {pair.seat + 1}: {difference}"
+    report.determinism = f"{where}: {difference}"
+    if any(p.was_late() for p in pairs):
         advice = ("it was late in one of them, and whether an answer is late depends on the "
                   "machine: a bot within its budget plays the same way every time")
     else:
         advice = ("draw any randomness from random.Random(seed) with the seed its "
                   "constructor gets, and never from the clock")
     report.reasons.append(f"it is not deterministic: {report.determinism}; {advice}")
+
+
+def _replayed_where(entries):
+    """What the determinism replay played, in words."""
+    opponent, game_seed, seat = entries[0]
+    if len(entries) == 1:
+        return f"seed {game_seed} against {opponent} from seat {seat + 1}, played twice"
+    seeds = sorted({s for _, s, _ in entries})
+    return (f"the {len(entries)} matches against {opponent} (seeds {seeds[0]} to {seeds[-1]}, "
+            "both seats), played together twice")
 
 
 def _first_difference(one, two, seat):

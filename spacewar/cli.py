@@ -165,6 +165,17 @@ def _add_window_commands(sub):
     _add_fault_options(w)
 
 
+def _gif_size(text):
+    """``--size``: a GIF side the renderer accepts, refused with the reason before any work."""
+    from .render import MAX_SIZE, MIN_SIZE
+
+    try:
+        return _int(text, MIN_SIZE, MAX_SIZE)
+    except argparse.ArgumentTypeError as exc:
+        raise argparse.ArgumentTypeError(f"{exc} (pixels a side: each frame takes about 8 "
+                                         f"bytes a pixel, 128 MiB at {MAX_SIZE})") from None
+
+
 def _add_replay_command(sub):
     from .keys import replay_epilog
 
@@ -178,7 +189,9 @@ def _add_replay_command(sub):
                       help="show it in a window: pause, step, slow motion, fast forward and "
                            "rewind, every frame re-simulated exactly (needs the [viz] extra)")
     r.add_argument("--every", type=_positive_int, default=2, help="draw every n-th frame (GIF)")
-    r.add_argument("--size", type=_positive_int, default=480, help="GIF side in pixels")
+    r.add_argument("--size", type=_gif_size, default=480,
+                   help="GIF side in pixels, 64 to 4096 (each frame takes about 8 bytes a "
+                        "pixel: 128 MiB at 4096)")
     r.add_argument("--fps", type=lambda text: _int(text, 1, 1000), default=60,
                    help="game frames a second at normal speed (--view)")
     r.add_argument("--speed", type=_speed, default=1.0,
@@ -248,6 +261,10 @@ def build_parser():
                     help="run the matches on a Dask cluster (as for tournament)")
     lg.add_argument("--json", action="store_true", help="print the results as JSON")
     lg.add_argument("--no-progress", action="store_true", help="no progress bar")
+    lg.add_argument("--trust-results", action="store_true",
+                    help="resume a results file that is not verified by your signing key "
+                         "(unsigned, another organizer's, or edited); its records are still "
+                         "checked, and the results and the table say it was resumed so")
     _add_rules_options(lg)
     _add_fault_options(lg)
 
@@ -294,8 +311,10 @@ def _add_author_commands(sub, fmt):
                             "within the budget, plays a seed the same way twice; exit 1 if not")
     c.add_argument("bot", metavar="BOT",
                    help="the bot: path/to/file.py:Class, package.module:Class or a built-in name")
-    c.add_argument("--games", type=_positive_int, default=1,
-                   help="seeds played against each opponent, each from both seats")
+    c.add_argument("--games", type=_positive_int, default=None,
+                   help="seeds played against each opponent, each from both seats; None: 1, "
+                        "or 10 for a batch bot, whose 2 x games matches against an opponent "
+                        "are played at once as in a tournament of that many games")
     c.add_argument("--seed", type=_seed, default=0,
                    help="the first seed; game g plays seed + g")
     c.add_argument("--rounds", type=_positive_int, default=1, help="rounds of each match")
@@ -309,7 +328,9 @@ def _add_author_commands(sub, fmt):
 
 
 def _describe_match(result, timing):
-    from .seats import FAULT_KINDS
+    """A match's result as text, every line escaped (``seats.printable``): the bots' names
+    are submissions' file names, and their fault messages their own words."""
+    from .seats import FAULT_KINDS, printable
 
     p1, p2 = result["bots"]
     a, b = result["score"]
@@ -333,7 +354,7 @@ def _describe_match(result, timing):
                          f"first: {f['examples'][0]['message']}")
     if timing is not None:
         lines.append(f"  {timing['frames_per_second']:.0f} frames/s with bots")
-    return "\n".join(lines)
+    return "\n".join(printable(line) for line in lines)
 
 
 def _cmd_bots(args):
@@ -413,11 +434,12 @@ def _cmd_league(args):
 
     from .bots import bots_in
     from .league import format_table, run_league
+    from .seats import printable
 
     if os.path.isdir(args.bots):
         bots, skipped = bots_in(args.bots)
         for path, reason in skipped.items():
-            print(f"spacewar league: skipped {path}: {reason}", file=sys.stderr)
+            print(f"spacewar league: skipped {printable(path)}: {reason}", file=sys.stderr)
     else:
         bots = [b.strip() for b in args.bots.split(",") if b.strip()]
     _check_policy_files(bots)
@@ -434,7 +456,7 @@ def _cmd_league(args):
         match_rounds=args.match_rounds, rules=_rules_from(args), workers=args.workers,
         progress=not args.no_progress and not args.json, limits=_limits_from(args),
         max_faults=args.max_faults, isolation=args.isolation, scheduler=args.scheduler,
-        bootstrap=args.bootstrap, on_round=report_round)
+        bootstrap=args.bootstrap, on_round=report_round, trust_results=args.trust_results)
     if args.json:
         print(json.dumps(results, sort_keys=True, indent=1))
     else:
@@ -574,10 +596,12 @@ def _cmd_new_bot(args):
 
 def _cmd_check(args):
     from .checker import check_bot
+    from .seats import printable
 
     def show(match):
         again = " (the same match again)" if match.get("repeat") else ""
-        print(f"  vs {match['opponent']}, seat {match['seat'] + 1}, seed {match['seed']}: "
+        print(f"  vs {printable(match['opponent'])}, seat {match['seat'] + 1}, "
+              f"seed {match['seed']}: "
               f"{match['outcome']} {match['score'][0]}-{match['score'][1]}{again}",
               file=sys.stderr)
 
@@ -601,15 +625,15 @@ def main(argv=None):
     args = build_parser().parse_args(argv)
     from .bots import BotLoadError
     from .replay import ReplayError
+    from .seats import printable
     from engine.cluster import CodeMismatch, SchedulerUnreachable
 
     try:
         return COMMANDS[args.command](args)
-    except (BotLoadError, ReplayError, ValueError, CodeMismatch, SchedulerUnreachable) as exc:
-        print(f"spacewar {args.command}: error: {exc}", file=sys.stderr)
-        return 2
-    except ImportError as exc:
-        print(f"spacewar {args.command}: error: {exc}", file=sys.stderr)
+    except (BotLoadError, ReplayError, ValueError, CodeMismatch, SchedulerUnreachable,
+            ImportError) as exc:
+        # an error may quote a submission's file name or words: shown escaped
+        print(f"spacewar {args.command}: error: {printable(str(exc))}", file=sys.stderr)
         return 2
 
 

@@ -5,18 +5,29 @@ worker exactly as a local worker process would (``spacewar.tournament._play``: e
 is not built in in its own confined process, with the same limits), so the results are the
 same, and they are put back in schedule order.
 
-A bot from a file travels as its bytes with their sha256, never as a pickled class: the worker
-checks the hash, writes the file once into a directory named by the hash (atomically), and
-plays it from there, each match loading it in a fresh confined process as at home. Module bots
-(``package.module:Class``) are refused: their code is a package that would have to be
-installed on every worker; give such a bot as a file.
+A bot from a file travels as its bytes with their sha256, never as a pickled class. For each
+task the worker checks every hash first, then writes the bytes into a private directory of the
+task's own (``private_copies``: an unpredictable name, the worker's user's alone, one
+sub-directory per entrant so that twins stay apart), plays them from there, each match loading
+its bot in a fresh confined process as at home, and removes the directory when the task ends,
+also on error. Nothing another local user could have written is read: no path of the worker's
+is reused from one task to the next. Module bots (``package.module:Class``) are refused: their
+code is a package that would have to be installed on every worker; give such a bot as a file.
+
+Entrants are named by the client's specifications: a task's jobs name them so, and a result
+comes back with the client's names of its two seats (``_named_by_seat``), never mapped back
+from a worker's path, so two entrants whose files have the same name and bytes stay two.
 """
+import contextlib
 import hashlib
 import os
+import shutil
+import stat
 import tempfile
 
 from engine import cluster
 
+from . import confinement
 from .bots import BotLoadError, _is_file_spec, _split, is_builtin, is_policy_file
 
 #: the largest bot file sent to a cluster (a policy file included)
@@ -40,40 +51,108 @@ def bot_files(bots):
                     "files can play (a module would have to be installed on every worker); "
                     "give it as path/to/file.py:Class")
             path = where
-        size = os.path.getsize(path)
-        if size > MAX_BOT_BYTES:
-            raise BotLoadError(f"bot file {path!r} is {size} bytes, more than the "
-                               f"{MAX_BOT_BYTES} a cluster run sends")
-        with open(path, "rb") as f:
-            data = f.read()
+        data = _read_bot_file(path)
         files[spec] = (os.path.basename(path), data, hashlib.sha256(data).hexdigest())
     return files
 
 
-def _materialise(name, data, digest):
-    """The path of the bot file on this worker: ``<tmp>/nbody-spacewar-bots/<sha256>/<name>``,
-    written once (atomically) after its bytes are checked against the hash."""
-    if hashlib.sha256(data).hexdigest() != digest:
-        raise ValueError(f"bot file {name!r} arrived with bytes that do not match its sha256")
-    folder = os.path.join(tempfile.gettempdir(), "nbody-spacewar-bots", digest)
-    path = os.path.join(folder, os.path.basename(name))
-    if not os.path.isfile(path):
-        os.makedirs(folder, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=folder, prefix=".arriving-")
-        with os.fdopen(fd, "wb") as f:
-            f.write(data)
-        os.chmod(tmp, 0o444)
-        os.replace(tmp, path)
+def _read_bot_file(path):
+    """The bytes of the bot file ``path``: a regular file (opened non-blocking, so a FIFO is
+    refused, not waited on) of at most ``MAX_BOT_BYTES``, read no further than that."""
+    fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_CLOEXEC)
+    with os.fdopen(fd, "rb") as f:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            raise BotLoadError(f"bot file {path!r} is not a regular file")
+        data = f.read(MAX_BOT_BYTES + 1)
+    if len(data) > MAX_BOT_BYTES:
+        raise BotLoadError(f"bot file {path!r} is more than the {MAX_BOT_BYTES} bytes a "
+                           "cluster run sends")
+    return data
+
+
+#: the start of the name of a task's private directory of bot copies (then the worker's pid)
+COPIES_PREFIX = "nbody-spacewar-bot-copies-"
+
+
+@contextlib.contextmanager
+def private_copies(files):
+    """``{client spec: spec on this worker}`` for the bots from files of one task
+    (``files``: ``bot_files``' entries), while the task runs. Every hash is checked before
+    anything is written; each bot's bytes are then written into a sub-directory of their own
+    in a fresh private directory (``tempfile.mkdtemp``), which is removed on leaving, also on
+    error."""
+    for name, data, digest in files.values():
+        if hashlib.sha256(data).hexdigest() != digest:
+            raise ValueError(f"bot file {name!r} arrived with bytes that do not match its "
+                             "sha256")
+    if not files:  # built-in bots only: nothing to write
+        yield {}
+        return
+    _sweep_stale_copies()
+    home = tempfile.mkdtemp(prefix=f"{COPIES_PREFIX}{os.getpid()}-")
+    try:
+        _open_to_the_bots_user(home)
+        local = {}
+        for spec, (name, data, _) in files.items():
+            path = _write_copy(home, name, data)
+            local[spec] = path if is_policy_file(spec) else f"{path}:{spec.rsplit(':', 1)[1]}"
+        yield local
+    finally:
+        shutil.rmtree(home, ignore_errors=True)
+
+
+def _write_copy(home, name, data):
+    """The path of ``data`` written as ``name`` in a new sub-directory of ``home``: each
+    entrant's own, so that two files of the same name never meet."""
+    from engine.atomic import atomic_write
+
+    folder = tempfile.mkdtemp(dir=home)
+    _open_to_the_bots_user(folder)
+    path = atomic_write(os.path.join(folder, os.path.basename(name)), data, mode="wb")
+    os.chmod(path, 0o444 if confinement.bot_uid() is not None else 0o400)
     return path
 
 
-def _local_specs(files):
-    """``{client spec: spec on this worker}`` for the bots from files."""
-    local = {}
-    for spec, (name, data, digest) in files.items():
-        path = _materialise(name, data, digest)
-        local[spec] = path if is_policy_file(spec) else f"{path}:{spec.rsplit(':', 1)[1]}"
-    return local
+def _open_to_the_bots_user(folder):
+    """Where bots run as another user (``nobody``, started by root), let it through
+    ``folder`` without listing it (0o711): the names inside are unpredictable, so only the
+    match, which was told them, finds the files; otherwise ``folder`` stays 0o700."""
+    if confinement.bot_uid() is not None:
+        os.chmod(folder, 0o711)
+
+
+def _sweep_stale_copies():
+    """Remove the copies of tasks whose worker died without removing them (a worker killed by
+    SIGKILL): this user's directories named after a pid that no longer runs."""
+    base = tempfile.gettempdir()
+    try:
+        names = os.listdir(base)
+    except OSError:
+        return
+    for name in names:
+        pid = name[len(COPIES_PREFIX):].split("-", 1)[0]
+        if not name.startswith(COPIES_PREFIX) or not pid.isdigit() or int(pid) == os.getpid():
+            continue
+        path = os.path.join(base, name)
+        try:
+            if os.lstat(path).st_uid != os.geteuid():
+                continue  # another user's: not ours to judge
+            os.kill(int(pid), 0)
+        except ProcessLookupError:
+            shutil.rmtree(path, ignore_errors=True)
+        except OSError:
+            pass  # gone already, or a live process of another user
+
+
+def _named_by_seat(result, pair):
+    """``result`` with the client's names ``pair`` of its two seats: who won and who forfeited
+    follow from the seats (the worker's names of the bots are paths of its own copies)."""
+    result["bots"] = list(pair)
+    if result.get("winner_seat") is not None:
+        result["winner"] = pair[result["winner_seat"]]
+    if result.get("forfeit") is not None:  # exactly one seat forfeited
+        result["forfeit"] = pair[result["forfeits"].index(True)]
+    return result
 
 
 def play_chunk(task, fingerprint):
@@ -83,20 +162,16 @@ def play_chunk(task, fingerprint):
     from .tournament import _play
 
     jobs, files = task
-    local = _local_specs(files)
-    back = {v: k for k, v in local.items()}
     out = []
-    for matches, together, *rest in jobs:
-        rest = list(rest)
-        rest[-1] = frozenset(local.get(s, s) for s in rest[-1])  # batch_files
-        mine = [(local.get(p1, p1), local.get(p2, p2), seed) for p1, p2, seed in matches]
-        outcomes = _play((mine, together, *rest))
-        for result, _ in outcomes:
-            result["bots"] = [back.get(b, b) for b in result["bots"]]
-            for key in ("winner", "forfeit"):  # the fields that name a bot
-                if result.get(key) is not None:
-                    result[key] = back.get(result[key], result[key])
-        out.append(outcomes)
+    with private_copies(files) as local:
+        for matches, together, *rest in jobs:
+            rest = list(rest)
+            rest[-1] = frozenset(local.get(s, s) for s in rest[-1])  # batch_files
+            mine = [(local.get(p1, p1), local.get(p2, p2), seed) for p1, p2, seed in matches]
+            outcomes = _play((mine, together, *rest))
+            for (result, _), (p1, p2, _) in zip(outcomes, matches, strict=True):
+                _named_by_seat(result, (p1, p2))
+            out.append(outcomes)
     return out
 
 

@@ -81,7 +81,10 @@ def play_match(p1, p2, seed=0, rounds=5, rules=None, budget=DEFAULT_BUDGET,
       ``faults`` (per seat), ``seed``, ``rounds_asked``, ``rules`` (a dict), ``output``;
     - ``replay``: the replay dict (``spacewar.replay``) when ``record`` is true, else None;
     - ``timing``: wall-clock figures, kept out of the result so that results are
-      byte-identical: ``wall_seconds``, ``frames_per_second``, ``act`` (per seat, a summary of
+      byte-identical: ``wall_seconds``, ``frames_per_second`` (both from the first seat's
+      opening to the last seat's closing), ``startup_seconds`` (until both seats were ready:
+      a confined bot's process started, confined, its module loaded), ``play_seconds`` and
+      ``play_frames_per_second`` (from then on: the frames alone), ``act`` (per seat, a summary of
       the time of each action as charged against the budget: ``count``, ``mean``, ``p50``,
       ``p95``, ``p99``, ``max`` in seconds, see ``act_time_summary``) and, when
       ``act_seconds`` is true, ``act_seconds`` (per seat, a float64 array of every action's
@@ -109,6 +112,7 @@ def play_match(p1, p2, seed=0, rounds=5, rules=None, budget=DEFAULT_BUDGET,
             if hasattr(seat, "wait_ready") and seat.wait_ready() is not None:
                 faults[s].add(0, *seat.dead)
                 forfeits[s] = True
+        ready = time.perf_counter()
         actions = np.full((1, 2), core.NOOP, dtype=np.int64)
         raws = np.empty((2, raw_length(rules)))  # every seat copies what it keeps
         for s in range(2):
@@ -140,9 +144,13 @@ def play_match(p1, p2, seed=0, rounds=5, rules=None, budget=DEFAULT_BUDGET,
     finally:
         for s, seat in enumerate(seats):
             outputs[s] = seat.close()
-    wall = time.perf_counter() - start
+    end = time.perf_counter()
+    wall = end - start
     result = _result(game, (bot_name(p1), bot_name(p2)), seed, rounds, rules, faults, forfeits, outputs)
-    result_timing = {"wall_seconds": wall, "frames_per_second": result["steps"] / max(wall, 1e-9)}
+    playing = end - ready
+    result_timing = {"wall_seconds": wall, "frames_per_second": result["steps"] / max(wall, 1e-9),
+                     "startup_seconds": ready - start, "play_seconds": playing,
+                     "play_frames_per_second": result["steps"] / max(playing, 1e-9)}
     times = [np.frombuffer(seat.act_seconds, dtype=np.float64).copy() for seat in seats]
     result_timing["act"] = [act_time_summary(t) for t in times]
     if act_seconds:

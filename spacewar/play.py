@@ -531,7 +531,7 @@ _ENDINGS = {"over": "the match is over", "quit": "quit before the end",
 def format_summary(summary):
     """The summary of ``play``/``watch`` as a small table for people to read."""
     result = summary["result"]
-    names = summary["players"]
+    names = [printable(name) for name in summary["players"]]  # file names: shown escaped
     rows = [("", "seat 1 (needle)", "seat 2 (wedge)"),
             ("player", *names),
             ("score", *map(str, summary["scores"])),

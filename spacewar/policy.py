@@ -5,9 +5,9 @@
     codes = policy.act_batch(obs)                  # (K, D) float32 -> (K,) int64 action codes
     bot = PolicyBot("policy.npz")                  # a bot: bot.act(observation) -> Action
 
-A policy file is a NumPy ``.npz`` archive written by ``spacewar.train`` (``save_policy``) and
-read here with ``np.load(..., allow_pickle=False)``: it holds only numeric arrays and one
-JSON text, so loading one runs no code from it. Its fields:
+A policy file is a NumPy ``.npz`` archive written by ``spacewar.train`` (``save_policy``): it
+holds only numeric arrays and two texts, read here without NumPy's loader or pickle, so
+loading one runs no code from it. Its fields:
 
 - ``format`` (the text ``"spacewar-policy"``), ``format_version`` (int64, now 1);
 - ``metadata``: a JSON object: ``observation_length`` (D), ``rules`` (``Rules.to_dict()``),
@@ -23,6 +23,19 @@ JSON text, so loading one runs no code from it. Its fields:
 
 Every array is checked for its dtype, shape and finiteness before use; a bad file raises
 ``PolicyError`` naming the field.
+
+A policy file comes from a stranger (a league loads every ``.npz`` in its submissions folder),
+so it is bounded by bytes before anything in it is inflated or parsed: the file is a regular
+file of at most ``MAX_FILE_BYTES`` (65 MiB: the largest legal policy stored uncompressed); its
+members are stored or deflated (what NumPy writes), each declaring at most 100 times its
+stored size once over 1 MiB, and together at most ``MAX_ARRAY_BYTES`` (64 MiB) uncompressed;
+each member's ``.npy`` magic and header length are read first and a header over
+``MAX_HEADER_BYTES`` (4 KiB) refused unread; its type and shape then give its bytes
+(item size times count, the two texts 0-d and of at most ``MAX_TEXT`` characters), checked
+against what is left of the 64 MiB before its data is read, a chunk at a time, and decoded
+from the bytes read (``np.frombuffer``). So ``Policy.load`` adds at most
+``LOAD_MEMORY_BOUND`` (about 161 MiB: the file, the arrays, the finiteness check's booleans
+and a few MiB of buffers) to its process, whatever the file.
 """
 import hashlib
 import io
@@ -119,7 +132,7 @@ def save_policy(path, weights, metadata):
     buffer = io.BytesIO()
     np.savez(buffer, **arrays)
     data = buffer.getvalue()
-    _parse(_read_npz(io.BytesIO(data), "the policy being saved"), "the policy being saved")
+    _parse(_read_npz(data, "the policy being saved"), "the policy being saved")
     return atomic_write(path, data, mode="wb")
 
 
@@ -128,9 +141,27 @@ def save_policy(path, weights, metadata):
 _MEMBER = re.compile(r"(format|format_version|metadata|inputs|[wb](?:[0-9]|1[0-5]))\.npy")
 #: the exact (little-endian) types of the weights and biases; the other numbers are int64
 _FIELD_TYPES = {"w": np.dtype("<f4"), "b": np.dtype("<f4")}
-MAX_FILE_BYTES = 1 << 28  # a policy file is at most 256 MiB
-MAX_TOTAL_NUMBERS = 1 << 24  # all of a policy's arrays hold at most 16 Mi numbers (64 MiB)
-MAX_TEXT = 1 << 16  # characters of the format and metadata texts
+_TEXT_FIELDS = ("format", "metadata")
+MAX_ARRAY_BYTES = 1 << 26  # all of a policy's arrays together: 64 MiB (16 Mi float32)
+MAX_TEXT = 1 << 16  # characters of the format and metadata texts (each one 0-d text)
+MAX_HEADER_BYTES = 4096  # a .npy member's header (NumPy writes < 1 KiB for a policy's)
+#: the largest legal policy stored without compression: its arrays, a header each and the
+#: archive's own records (36 members at most); a larger file cannot be a policy
+MAX_FILE_BYTES = MAX_ARRAY_BYTES + (1 << 20)
+#: a member over RATIO_FREE_BYTES may inflate at most MAX_RATIO times its stored size
+#: (trained float32 weights barely compress: a larger ratio is a bomb, not a policy)
+MAX_RATIO = 100
+RATIO_FREE_BYTES = 1 << 20
+#: central-directory signatures a file may hold: one per member (36 at most) with room for
+#: the chance occurrences of these 4 bytes inside arrays
+MAX_DIRECTORY_ENTRIES = 64
+#: what NumPy writes (np.savez, np.savez_compressed); bzip2 and LZMA decompressors inflate
+#: without an output bound (bzip2) or allocate a dictionary the file names (LZMA)
+_METHODS = frozenset((zipfile.ZIP_STORED, zipfile.ZIP_DEFLATED))
+_READ_CHUNK = 1 << 20
+#: the most memory ``Policy.load`` adds to its process: the file's bytes, the decoded arrays,
+#: the finiteness check's booleans (one per float32) and a few MiB of chunks and zlib state
+LOAD_MEMORY_BOUND = MAX_FILE_BYTES + MAX_ARRAY_BYTES + MAX_ARRAY_BYTES // 4 + (16 << 20)
 
 
 def read_policy_bytes(path, where):
@@ -148,9 +179,13 @@ def read_policy_bytes(path, where):
         if info.st_size > MAX_FILE_BYTES:
             raise PolicyError(f"{where} has {info.st_size} bytes, over the {MAX_FILE_BYTES} a "
                               "policy file may have")
+        # one read of the whole file (then b"".join returns that very object: the bytes are
+        # held once, not twice); more reads only if it grows meanwhile
         chunks, left = [], MAX_FILE_BYTES + 1
+        size = info.st_size + 1
         while left > 0:
-            chunk = os.read(fd, min(left, 1 << 20))
+            chunk = os.read(fd, min(left, size))
+            size = 1 << 20
             if not chunk:
                 break
             chunks.append(chunk)
@@ -165,70 +200,157 @@ def read_policy_bytes(path, where):
         os.close(fd)
 
 
-def _read_npz(source, where):
-    """Every array of an .npz, all of its members' names, types and sizes checked from their
-    headers before any data is read; every failure is a ``PolicyError``."""
+def _read_npz(data, where):
+    """Every array of an .npz (``data``: the file's bytes), each member's declared sizes,
+    method and ``.npy`` header checked before its data is inflated, the arrays decoded from
+    the bytes read; every failure is a ``PolicyError``."""
     try:
-        return _read_checked_npz(source, where)
+        return _read_checked_npz(data, where)
     except PolicyError:
         raise
     except MemoryError:
         raise PolicyError(f"{where} is too large to read") from None
     except zipfile.BadZipFile as exc:
         raise PolicyError(f"{where} is not an .npz archive: {exc}") from None
-    except Exception as exc:  # zlib, bz2, lzma, zipfile: any archive that cannot be read
+    except Exception as exc:  # zlib, zipfile: any archive that cannot be read
         raise PolicyError(f"{where} cannot be read as an .npz archive: "
                           f"{type(exc).__name__}: {exc}") from None
 
 
-def _read_checked_npz(source, where):
-    total = 0
-    with zipfile.ZipFile(source) as archive:
+def _read_checked_npz(data, where):
+    _check_directory_entries(data, where)
+    arrays, budget = {}, MAX_ARRAY_BYTES
+    with zipfile.ZipFile(io.BytesIO(data)) as archive:
         infos = archive.infolist()
-        names = [info.filename for info in infos]
-        for name in names:
-            if not _MEMBER.fullmatch(name):
-                raise PolicyError(f"{where}: unexpected member {name[:100]!r} in the archive")
-        if len(set(names)) != len(names):
-            raise PolicyError(f"{where}: a member appears twice in the archive")
+        _check_members(infos, where)
         for info in infos:
             field = info.filename[:-4]
-            with archive.open(info) as f:
-                try:
-                    version = np.lib.format.read_magic(f)
-                    read_header = {(1, 0): np.lib.format.read_array_header_1_0,
-                                   (2, 0): np.lib.format.read_array_header_2_0}.get(version)
-                    if read_header is None:
-                        raise ValueError(f"unknown .npy format version {version}")
-                    shape, fortran, dtype = read_header(f)
-                    header_bytes = f.tell()
-                except ValueError as exc:
-                    raise PolicyError(f"{where}: field {field!r} is not a NumPy array: "
-                                      f"{exc}") from None
-            if dtype.hasobject:
-                raise PolicyError(f"{where}: field {field!r} holds Python objects (pickled "
-                                  "data), which a policy never does")
-            if field in ("format", "metadata"):
-                if dtype.kind != "U" or dtype.byteorder not in "<=|" \
-                        or dtype.itemsize > 4 * MAX_TEXT:
-                    raise PolicyError(f"{where}: field {field!r} must be a text of at most "
-                                      f"{MAX_TEXT} characters, got {dtype.str}")
-            elif dtype != _FIELD_TYPES.get(field[0], np.dtype("<i8")):
-                raise PolicyError(f"{where}: field {field!r} must be "
-                                  f"{_FIELD_TYPES.get(field[0], np.dtype('<i8')).name}, got "
-                                  f"{dtype.str}")
-            numbers = math.prod(shape)
-            total += numbers
-            if numbers > MAX_ELEMENTS or total > MAX_TOTAL_NUMBERS:
-                raise PolicyError(f"{where}: field {field!r} has shape {shape}, over the "
-                                  f"{MAX_TOTAL_NUMBERS} numbers a policy may hold in all")
-            if info.file_size != header_bytes + numbers * dtype.itemsize:
-                raise PolicyError(f"{where}: field {field!r} declares {info.file_size} bytes "
-                                  "where its header says otherwise")
-        if hasattr(source, "seek"):
-            source.seek(0)
-    with np.load(source, allow_pickle=False) as npz:
-        return {name: npz[name] for name in npz.files}
+            with archive.open(info) as member:
+                arrays[field] = _read_member(member, info.file_size, field, budget, where)
+            budget -= arrays[field].nbytes
+    return arrays
+
+
+def _check_directory_entries(data, where):
+    """Refuse an archive whose central directory could list more than
+    ``MAX_DIRECTORY_ENTRIES`` members before ``zipfile`` reads it: it makes an object for each
+    entry, and 64 MiB hold a million entries. Each entry starts with its 4-byte signature
+    somewhere in the file, so their count bounds the entries."""
+    entries = data.count(b"PK\x01\x02")
+    if entries > MAX_DIRECTORY_ENTRIES:
+        raise PolicyError(f"{where}: the archive may list {entries} members; a policy has at "
+                          f"most {MAX_DIRECTORY_ENTRIES}")
+
+
+def _check_members(infos, where):
+    """Names, methods and declared sizes of every member, before any is opened."""
+    names = [info.filename for info in infos]
+    for name in names:
+        if not _MEMBER.fullmatch(name):
+            raise PolicyError(f"{where}: unexpected member {name[:100]!r} in the archive")
+    if len(set(names)) != len(names):
+        raise PolicyError(f"{where}: a member appears twice in the archive")
+    declared = 0
+    for info in infos:
+        field = info.filename[:-4]
+        if info.flag_bits & 0x1:
+            raise PolicyError(f"{where}: field {field!r} is encrypted")
+        if info.compress_type not in _METHODS:
+            raise PolicyError(f"{where}: field {field!r} is compressed with zip method "
+                              f"{info.compress_type}; a policy's members are stored or "
+                              "deflated (as np.savez and np.savez_compressed write them)")
+        declared += info.file_size
+        if declared > MAX_ARRAY_BYTES + len(infos) * (MAX_HEADER_BYTES + 12):
+            raise PolicyError(f"{where}: the members declare {declared} bytes or more "
+                              f"uncompressed, over the {MAX_ARRAY_BYTES} a policy's arrays "
+                              "may hold")
+        if info.file_size > RATIO_FREE_BYTES \
+                and info.file_size > MAX_RATIO * max(info.compress_size, 1):
+            raise PolicyError(f"{where}: field {field!r} declares {info.file_size} bytes "
+                              f"stored in {info.compress_size}, over the {MAX_RATIO}:1 a "
+                              "policy's arrays compress to")
+
+
+def _read_member(member, declared, field, budget, where):
+    """The array of one ``.npy`` member: its magic and header length read and checked, then
+    its header (at most ``MAX_HEADER_BYTES``), its type, shape and byte count (at most
+    ``budget``), and only then its data, decoded from the bytes read."""
+    magic = _read_exactly(member, 8, field, where)
+    if magic[:6] != b"\x93NUMPY" or magic[6:] not in (b"\x01\x00", b"\x02\x00"):
+        raise PolicyError(f"{where}: field {field!r} is not a NumPy .npy array of version 1 "
+                          f"or 2 (it starts {magic!r})")
+    width = 2 if magic[6] == 1 else 4
+    length_field = _read_exactly(member, width, field, where)
+    length = int.from_bytes(length_field, "little")
+    if length > MAX_HEADER_BYTES:
+        raise PolicyError(f"{where}: field {field!r} has a .npy header of {length} bytes, over "
+                          f"the {MAX_HEADER_BYTES} a policy's array needs")
+    header = magic + length_field + _read_exactly(member, length, field, where)
+    shape, fortran, dtype = _parse_header(header, magic[6], field, where)
+    _check_type(field, dtype, shape, where)
+    if any(size < 0 for size in shape):
+        raise PolicyError(f"{where}: field {field!r} has a negative size in its shape {shape}")
+    nbytes = math.prod(shape) * dtype.itemsize
+    if nbytes > budget:
+        raise PolicyError(f"{where}: field {field!r} has shape {shape} and type {dtype.str}: "
+                          f"{nbytes} bytes, over the {MAX_ARRAY_BYTES} a policy's arrays may "
+                          "hold in all")
+    if declared != len(header) + nbytes:
+        raise PolicyError(f"{where}: field {field!r} declares {declared} bytes where its "
+                          f"header says {len(header) + nbytes}")
+    data = bytearray(nbytes)
+    _read_into(member, memoryview(data), field, where)
+    array = np.frombuffer(data, dtype=dtype, count=math.prod(shape))
+    return array.reshape(shape, order="F" if fortran else "C")
+
+
+def _read_exactly(member, count, field, where):
+    data = bytearray(count)
+    _read_into(member, memoryview(data), field, where)
+    return bytes(data)
+
+
+def _read_into(member, view, field, where):
+    """Fill ``view`` from the member, a chunk at a time (the inflater never makes more than
+    a chunk at once); refuse a member that ends early."""
+    done = 0
+    while done < len(view):
+        chunk = member.read(min(_READ_CHUNK, len(view) - done))
+        if not chunk:
+            raise PolicyError(f"{where}: field {field!r} ends after {done} of the "
+                              f"{len(view)} bytes its header declares")
+        view[done:done + len(chunk)] = chunk
+        done += len(chunk)
+
+
+def _parse_header(header, version, field, where):
+    """``(shape, fortran_order, dtype)`` of a bounded ``.npy`` header (NumPy's own parser,
+    which evaluates literals only, given the bytes already read and checked)."""
+    read = np.lib.format.read_array_header_1_0 if version == 1 else \
+        np.lib.format.read_array_header_2_0
+    stream = io.BytesIO(header)
+    np.lib.format.read_magic(stream)
+    try:
+        return read(stream, max_header_size=MAX_HEADER_BYTES)
+    except (ValueError, SyntaxError, TypeError) as exc:
+        raise PolicyError(f"{where}: field {field!r} has no valid .npy header: "
+                          f"{str(exc)[:200]}") from None
+
+
+def _check_type(field, dtype, shape, where):
+    """The type and, for the texts, the shape a policy's field must have."""
+    if dtype.hasobject:
+        raise PolicyError(f"{where}: field {field!r} holds Python objects (pickled data), "
+                          "which a policy never does")
+    if field in _TEXT_FIELDS:
+        if dtype.kind != "U" or dtype.byteorder not in "<=|" or shape != () \
+                or not 0 < dtype.itemsize <= 4 * MAX_TEXT:
+            raise PolicyError(f"{where}: field {field!r} must be a text of at most {MAX_TEXT} "
+                              f"characters (one, a 0-d array), got {dtype.str} of shape {shape}")
+        return
+    want = _FIELD_TYPES.get(field[0], np.dtype("<i8"))
+    if dtype != want:
+        raise PolicyError(f"{where}: field {field!r} must be {want.name}, got {dtype.str}")
 
 
 def _field(arrays, name, where):
@@ -353,7 +475,7 @@ class Policy:
         """Read and validate a policy file (``np.load(..., allow_pickle=False)``)."""
         where = f"policy file {os.fspath(path)!r}"
         data = read_policy_bytes(path, where)
-        return cls(*_parse(_read_npz(io.BytesIO(data), where), where))
+        return cls(*_parse(_read_npz(data, where), where))
 
     def logits(self, obs, seat=0):
         """The 9 logits (turn 3, thrust 2, fire 2, hyperspace 2) of each row of ``obs``

@@ -695,9 +695,16 @@ class _Enough(Exception):
     """Raised inside the replay callback once ``max_frames`` frames are drawn."""
 
 
+#: the largest image side in pixels: a frame's buffers (the painted image, the previous
+#: frame, the changed-pixel mask and the encoder's copy) take about 8 bytes a pixel, so
+#: 4096 keeps them near 128 MiB, where 10^6 would ask for terabytes
+MIN_SIZE, MAX_SIZE = 64, 4096
+
+
 def _check_size(size):
-    if isinstance(size, bool) or not isinstance(size, int) or size < 64:
-        raise ValueError(f"size must be an int >= 64 (pixels), got {size!r}")
+    if isinstance(size, bool) or not isinstance(size, int) or not MIN_SIZE <= size <= MAX_SIZE:
+        raise ValueError(f"size must be an int in [{MIN_SIZE}, {MAX_SIZE}] (pixels a side; "
+                         f"a frame takes about 8 bytes a pixel), got {size!r}")
     return size
 
 

@@ -29,6 +29,7 @@ import json
 import math
 import os
 import secrets
+import stat
 
 import numpy as np
 
@@ -194,9 +195,19 @@ def _mac(key, replay):
     return hmac.new(key, canonical_json(body).encode("ascii"), hashlib.sha256).hexdigest()
 
 
+def sign(document):
+    """The ``signature`` field for ``document`` (a dict of plain JSON data: a replay, or a
+    league's results file; its own ``signature`` and ``content_sha256`` fields are left out):
+    an HMAC-SHA256 of its canonical JSON with this user's key (``key_path()``, made on first
+    use). ``signature_status`` checks it. TypeError or ValueError if it is not plain data."""
+    key = _key(create=True)
+    return {"key": _key_id(key), "hmac_sha256": _mac(key, document)}
+
+
 def signature_status(replay):
     """``"verified"`` (signed with this user's key and unchanged since), ``"unsigned"``,
-    ``"other key"`` (signed elsewhere: cannot be verified here) or ``"forged"``.
+    ``"other key"`` (signed elsewhere: cannot be verified here) or ``"forged"``, for a replay
+    or any document signed by ``sign``.
 
     The content digest catches accidents, but anyone can recompute it; the signature is an
     HMAC-SHA256 with a key only its owner has, so records the simulation cannot re-derive
@@ -231,9 +242,10 @@ def save(path, replay):
     data["version"] = data.get("version", VERSION)
     if data["version"] == VERSION:
         path = check_output_path(path, "replay")  # before a key is made for it
-        key = _key(create=True)
         try:
-            data[SIGNATURE_FIELD] = {"key": _key_id(key), "hmac_sha256": _mac(key, data)}
+            data[SIGNATURE_FIELD] = sign(data)
+        except ReplayError:  # an unreadable key: its own message
+            raise
         except (TypeError, ValueError) as exc:
             raise ReplayError(f"replay to save is not plain JSON data: {exc}") from None
         data[DIGEST_FIELD] = digest(data)
@@ -260,13 +272,7 @@ def load(path):
     ReplayError with a message naming the problem; never another exception.
     """
     shown = os.fspath(path) if isinstance(path, (str, bytes, os.PathLike)) else path
-    try:
-        with open(path, "rb") as f:
-            raw = f.read(MAX_FILE_BYTES + 1)
-    except (OSError, TypeError, ValueError) as exc:
-        raise ReplayError(f"cannot read replay {shown!r}: {exc}") from exc
-    if len(raw) > MAX_FILE_BYTES:
-        raise ReplayError(f"{shown!r} is larger than {MAX_FILE_BYTES} bytes: not a replay")
+    raw = _read_replay_bytes(path, shown)
     try:
         data = json.loads(raw, parse_constant=_reject_constant)
     except RecursionError:
@@ -274,6 +280,34 @@ def load(path):
     except (ValueError, TypeError) as exc:  # JSONDecodeError, int digit limit, bad UTF-8
         raise ReplayError(f"{shown!r} is not a JSON replay: {exc}") from None
     return validate(data, repr(shown), require_digest=True)
+
+
+def _read_replay_bytes(path, shown):
+    """The bytes of the replay file at ``path``: a regular file (a FIFO would block ``open``
+    for ever, a device never end), opened without blocking and checked by ``fstat`` on the
+    descriptor it is then read from, of at most ``MAX_FILE_BYTES`` (a replay holds about 6
+    bytes a frame: 64 MiB is over 10 million frames, far beyond any match)."""
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+    except (OSError, TypeError, ValueError) as exc:
+        raise ReplayError(f"cannot read replay {shown!r}: {exc}") from None
+    try:
+        info = os.fstat(fd)
+        if not stat.S_ISREG(info.st_mode):
+            raise ReplayError(f"cannot read replay {shown!r}: not a regular file (a replay is "
+                              "a JSON file; pipes and devices are refused)")
+        if info.st_size > MAX_FILE_BYTES:
+            raise ReplayError(f"{shown!r} has {info.st_size} bytes, over the {MAX_FILE_BYTES} "
+                              "a replay may have: not a replay")
+        with os.fdopen(fd, "rb", closefd=False) as f:
+            raw = f.read(MAX_FILE_BYTES + 1)
+    except OSError as exc:
+        raise ReplayError(f"cannot read replay {shown!r}: {exc}") from None
+    finally:
+        os.close(fd)
+    if len(raw) > MAX_FILE_BYTES:
+        raise ReplayError(f"{shown!r} is larger than {MAX_FILE_BYTES} bytes: not a replay")
+    return raw
 
 
 def _fail(source, message):

@@ -30,6 +30,80 @@ MODES = ("classic", "newtonian", "electric")
 STARS = ("heavy", "light", "none")
 
 
+#: the longest span a frame-count field may give: 2^30 frames (about 5 hours at 60 frames
+#: a second). A match's frame counter then stays under (rounds + extra rounds) x (round
+#: frames + delay + 1) < 2^31 x 2^31 = 2^62 for any replay's rounds (< 2^31): int64 holds it,
+#: and every count is exact in the float64 rules vector the compiled game reads.
+FRAMES_MAX = 1 << 30
+
+#: every number's inclusive range, chosen so that each compiled expression stays finite and
+#: in range: counts are exact in float64 and their products fit in int64; a frame's speed
+#: and thrust changes are at most an arena side (beyond it the torus wraps them to nothing
+#: new); masses and softening radii are bounded away from 0 so that forces divided by them
+#: stay finite (at most about 1e21 a frame, and speeds summed over 2^62 frames far below
+#: 1e308); turning at most a quarter turn a frame keeps the heading's one-step wrap (and the
+#: four-times-faster spin limit) within (-pi, pi]; the star's capture radius is at most
+#: 1/16, so that the re-entry point drawn outside 6 radii (<= 0.375) is found in a few
+#: draws instead of never.
+RANGES = {
+    "star_mu": (0.0, 1.0),
+    "star_capture": (1e-6, 1.0 / 16.0),
+    "turn_rate": (0.0, math.pi / 4.0),
+    "angular_accel": (0.0, math.pi / 4.0),
+    "thrust": (0.0, 1.0),
+    "fuel": (0.0, float(FRAMES_MAX)),
+    "fuel_burn_min": (0.0, float(FRAMES_MAX)),
+    "fuel_burn_max": (0.0, float(FRAMES_MAX)),
+    "ship_mass": (1e-6, 1e6),
+    "start_distance": (1e-6, 0.5),
+    "torpedoes": (1, 64),
+    "reload": (0, FRAMES_MAX),
+    "torpedo_life": (0, FRAMES_MAX),
+    "muzzle_speed": (0.0, 1.0),
+    "launch_offset": (0.0, 1.0),
+    "torpedo_mass": (1e-6, 1e6),
+    "hyperspace_jumps": (0, FRAMES_MAX),
+    "hyperspace_frames": (0, FRAMES_MAX),
+    "hyperspace_recharge": (0, FRAMES_MAX),
+    "hyperspace_risk": (0.0, 1.0),
+    "reentry_speed": (0.0, 1.0),
+    "hit_box": (1e-6, 0.5),
+    "hit_diamond": (0.0, 1.0),
+    "post_round_delay": (0, FRAMES_MAX),
+    "max_round_frames": (0, FRAMES_MAX),
+    "max_extra_rounds": (0, 1 << 20),
+    "ship_gravity": (0.0, 1.0),
+    "coulomb_k": (0.0, 1e3),
+    "charge": (0.0, 1.0),
+    "flip_cooldown": (0, FRAMES_MAX),
+}
+
+
+def _shown(value, limit=40):
+    """``repr(value)``, cut short (a forged file's int may have thousands of digits)."""
+    if isinstance(value, int) and not isinstance(value, bool) and value.bit_length() > 128:
+        return f"an int of {value.bit_length()} bits"
+    text = repr(value)
+    return text if len(text) <= limit else text[:limit] + "..."
+
+
+def _check_number(name, value, kind):
+    """Raise ValueError naming the field, the value and its range unless ``value`` is of
+    ``kind`` ("float": an int or a float; "int": an int, not a bool) and within
+    ``RANGES[name]``. Compared as given: a huge int is never converted to a float."""
+    low, high = RANGES[name]
+    if kind == "int":
+        ok = not isinstance(value, bool) and isinstance(value, (int, np.integer))
+        what = "an int"
+    else:
+        ok = not isinstance(value, bool) and isinstance(value, (int, float))
+        what = "a number"
+    if not ok:
+        raise ValueError(f"{name} must be {what} in [{low!r}, {high!r}], got {_shown(value)}")
+    if not low <= value <= high:  # False for NaN too
+        raise ValueError(f"{name} must be in [{low!r}, {high!r}], got {_shown(value)}")
+
+
 def count_at_least(name, value, minimum):
     """``value`` as an int if it is one (not a bool) of at least ``minimum``, else a
     ValueError naming the field and the value (seeds, rounds, frame caps, env counts)."""
@@ -40,7 +114,30 @@ def count_at_least(name, value, minimum):
 
 @dataclass(frozen=True)
 class Rules:
-    """Every number the game uses. Frozen: make variants with ``rules.replace(...)``."""
+    """Every number the game uses. Frozen: make variants with ``rules.replace(...)``.
+
+    Each number must lie in its range (``RANGES``, inclusive; why each bound: there), else
+    ValueError names the field, the value and the range; rules read from replays, policy
+    files and leagues come through ``from_dict`` and so through the same check:
+
+    ==========================================================  =========================
+    field                                                       range
+    ==========================================================  =========================
+    star_mu, thrust, muzzle_speed, reentry_speed, ship_gravity  [0, 1]
+    hyperspace_risk, launch_offset, hit_diamond, charge         [0, 1]
+    turn_rate, angular_accel (rad per frame, per frame^2)       [0, pi/4]
+    star_capture                                                [1e-6, 1/16]
+    hit_box, start_distance                                     [1e-6, 0.5]
+    ship_mass, torpedo_mass                                     [1e-6, 1e6]
+    coulomb_k                                                   [0, 1e3]
+    fuel, fuel_burn_min, fuel_burn_max (<= fuel_burn_max)       [0, 2^30]
+    reload, torpedo_life, hyperspace_jumps, hyperspace_frames   [0, 2^30] (ints)
+    hyperspace_recharge, post_round_delay, max_round_frames     [0, 2^30] (ints)
+    flip_cooldown                                               [0, 2^30] (int)
+    max_extra_rounds                                            [0, 2^20] (int)
+    torpedoes                                                   [1, 64] (int)
+    ==========================================================  =========================
+    """
 
     mode: str = "classic"
     # sense switches
@@ -98,24 +195,14 @@ class Rules:
         for f in dataclasses.fields(self):
             value = getattr(self, f.name)
             if f.type in ("float", float):
-                if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-                    raise ValueError(f"{f.name} must be a finite number, got {value!r}")
-                if value < 0:
-                    raise ValueError(f"{f.name} must be >= 0, got {value!r}")
+                _check_number(f.name, value, "float")
             elif f.type in ("int", int):
-                if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
-                    raise ValueError(f"{f.name} must be an int >= 0, got {value!r}")
+                _check_number(f.name, value, "int")
             elif f.type in ("bool", bool) and not isinstance(value, bool):
-                raise ValueError(f"{f.name} must be True or False, got {value!r}")
-        if not 1 <= self.torpedoes <= 64:
-            raise ValueError(f"torpedoes must be in [1, 64], got {self.torpedoes!r}")
+                raise ValueError(f"{f.name} must be True or False, got {_shown(value)}")
         if self.fuel_burn_max < self.fuel_burn_min:
             raise ValueError(f"fuel_burn_max ({self.fuel_burn_max!r}) must be >= fuel_burn_min "
                              f"({self.fuel_burn_min!r})")
-        if self.ship_mass <= 0 or self.torpedo_mass <= 0:
-            raise ValueError("ship_mass and torpedo_mass must be > 0")
-        if not 0 < self.start_distance < 0.5:
-            raise ValueError(f"start_distance must be in (0, 0.5), got {self.start_distance!r}")
 
     @property
     def effective_star_mu(self):

@@ -349,8 +349,8 @@ class ProcessSeat:
         if self._pending is None and (self._reader.buffer or self._unsolicited()):
             return None, self.dead or self._stop(
                 "invalid", "broke the protocol: answered before being asked"), None
-        self._resume()
         if self._pending is not None:
+            self._resume()  # it finishes the frame it is late with, on this turn's time
             late_frame, _ = self._pending
             window = time.monotonic()
             answer = self._receive(window + budget)
@@ -365,8 +365,12 @@ class ProcessSeat:
                 return None, ("timeout", f"still busy with {self._asked} {late_frame}"), None
             self._pending = None  # the late answer to an earlier frame: that one was a no-op
         sent = time.monotonic()
+        # Written while the bot is still stopped, then continued: it wakes once, with its
+        # question already in the pipe (continued first, it would wake to an empty pipe, sleep
+        # and be woken again by the write: one more wake-up of another processor a turn).
         if not self._send(message, sent + allowance):
             return None, self.dead or self._stop("timeout", "did not read its observation"), None
+        self._resume()
         self._pending, self._busy_for = (frame, sent), 0.0
         answer = self._receive(sent + allowance)
         if answer is None:
@@ -379,10 +383,9 @@ class ProcessSeat:
         return answer, None, time.monotonic() - sent
 
     def _unsolicited(self):
-        """Whether the bot wrote anything while it was not asked (it is stopped now), or died."""
+        """Whether the bot wrote anything while it was not asked (it is stopped now), or died.
+        One read of the non-blocking pipe answers both (an empty pipe raises at once)."""
         try:
-            if not select.select([self._from_bot], [], [], 0)[0]:
-                return False
             data = os.read(self._from_bot, 1 << 16)
         except BlockingIOError:
             return False
@@ -411,7 +414,7 @@ class ProcessSeat:
                 view = view[os.write(self._to_bot, view):]
                 continue
             except BlockingIOError:
-                pass
+                self._resume()  # the pipe is full (a large batch): the bot must read on
             except OSError:
                 self._died()
                 return False
@@ -423,8 +426,8 @@ class ProcessSeat:
     def _receive(self, deadline):
         """The next answer, or None at the deadline or when the bot dies or misbehaves."""
         while True:
-            try:
-                answer = self._reader.next()
+            try:  # an empty buffer (the common case: nothing read yet) holds no answer
+                answer = self._reader.next() if self._reader.buffer else None
             except wire.WireError as exc:
                 self._stop("invalid", f"broke the protocol: {exc}")
                 return None
@@ -596,10 +599,12 @@ class BatchProcessSeat(ProcessSeat):
         ``allowance`` s (a late answer to the previous call: ``budget`` s).
 
         Returns ``(status, codes, text, seconds, fault)``: with an answer, ``status`` is the
-        wire's (``codes`` the (rows,) int64 codes when OK, else None; INVALID when the codes
-        are not ``rows`` valid ones), ``seconds`` how long it took and ``fault`` None; without
-        one, ``status`` is None and ``fault`` says why (``self.dead`` set when the bot can
-        play no more), ``seconds`` the allowance when it was silent for all of it."""
+        wire's (``codes`` the (rows,) int64 codes when OK, else None; INVALID when one of the
+        ``rows`` codes is out of range), ``seconds`` how long it took and ``fault`` None;
+        without one, ``status`` is None and ``fault`` says why (``self.dead`` set when the bot
+        can play no more: a count of codes other than ``rows`` on an OK answer, or any on
+        another, breaks the protocol), ``seconds`` the allowance when it was silent for all
+        of it."""
         if self.dead is not None:
             return None, None, "", None, self.dead
         try:
@@ -611,10 +616,7 @@ class BatchProcessSeat(ProcessSeat):
         if answer is None:
             return None, None, "", seconds, fault
         _, status, data, text = answer
-        if status == wire.OK:
-            if len(data) != self._batch_rows:
-                return (wire.INVALID, None, f"answered {len(data)} action codes for "
-                        f"{self._batch_rows} matches", seconds, None)
+        if status == wire.OK:  # exactly one code a row (the reader's check: else a breach)
             found = np.frombuffer(data, dtype=np.uint8).astype(np.int64)
             bad = found >= codes.N_ACTIONS
             if bad.any():

@@ -25,7 +25,7 @@ import numpy as np
 
 from .match import DEFAULT_BUDGET, DEFAULT_MAX_FAULTS, play_match
 from .rules import Rules
-from .seats import Limits
+from .seats import Limits, printable
 
 
 def schedule(bots, games, seed):
@@ -153,10 +153,11 @@ def run_tournament(bots, games=10, seed=1, rounds=3, rules=None, workers=None, p
         raise ValueError(f"each bot may enter once, got {bots!r}")
     if isinstance(games, bool) or not isinstance(games, int) or games < 1:
         raise ValueError(f"games must be an int >= 1, got {games!r}")
-    from .bots import locate
+    from .bots import check_one_spelling_each, locate
 
     for spec in bots:
         locate(spec)  # unknown names and missing files fail here; no bot code runs here
+    check_one_spelling_each(bots)  # a.py:X and ./a.py:X would be one bot entered twice
     rules = Rules() if rules is None else rules
     workers = (os.cpu_count() or 1) if workers is None else workers
     if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
@@ -303,11 +304,13 @@ def _progress(total, enabled, what="tournament"):
 
 
 def format_table(report):
-    """The table as fixed-width text."""
+    """The table as fixed-width text; a bot's name (a submission's file name) shown escaped
+    (``seats.printable``): it cannot redraw the organizer's terminal."""
     lines = [f"{'bot':<24}{'played':>7}{'wins':>6}{'draws':>7}{'losses':>8}{'points':>9}"
              f"{'faults':>8}{'elo':>8}"]
     for row in report["table"]:
-        lines.append(f"{row['bot']:<24}{row['played']:>7}{row['wins']:>6}{row['draws']:>7}"
-                     f"{row['losses']:>8}{row['points_for']:>5}-{row['points_against']:<3}"
+        lines.append(f"{printable(row['bot']):<24}{row['played']:>7}{row['wins']:>6}"
+                     f"{row['draws']:>7}{row['losses']:>8}"
+                     f"{row['points_for']:>5}-{row['points_against']:<3}"
                      f"{row['faults']:>8}{row['elo']:>8.0f}")
     return "\n".join(lines)

@@ -175,7 +175,8 @@ class AnswerReader:
     the stream cannot be an answer (wrong magic, unknown status, text over the cap).
 
     With ``rows`` set (a batch bot in play) it reads CODES instead: ``next()`` returns
-    ``(call, status, codes, text)``, ``codes`` the bytes of exactly ``rows`` action codes.
+    ``(call, status, codes, text)``, ``codes`` the bytes of exactly ``rows`` action codes
+    when the status is OK, and none otherwise (any other count: ``_check_code_count``).
     """
 
     def __init__(self, rows=None):
@@ -210,8 +211,8 @@ class AnswerReader:
             raise WireError(f"unknown answer status {status}")
         if length > MAX_TEXT:
             raise WireError(f"answer text of {length} bytes exceeds {MAX_TEXT}")
-        if self.rows is not None and count not in (0, self.rows):
-            raise WireError(f"answered {count} codes for a batch of {self.rows}")
+        if self.rows is not None:
+            _check_code_count(status, count, self.rows)
         end = header.size + count + length
         if len(self.buffer) < end:
             return None
@@ -220,3 +221,12 @@ class AnswerReader:
             code = bytes(self.buffer[header.size:header.size + count])
         del self.buffer[:end]
         return frame, status, code, text
+
+
+def _check_code_count(status, count, rows):
+    """A CODES answer holds one code per row when its status is OK and none otherwise: any
+    other count (none with OK included) is a WireError, a breach of the protocol."""
+    expected = rows if status == OK else 0
+    if count != expected:
+        raise WireError(f"answered {count} codes for a batch of {rows} with status "
+                        f"{STATUS_NAMES[status]!r} (expected {expected})")

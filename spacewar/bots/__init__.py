@@ -370,6 +370,45 @@ def _module_source(where):
     return None if found is None else found.origin
 
 
+def check_one_spelling_each(specs):
+    """Raise ``BotLoadError`` naming both spellings when two of ``specs`` name the same bot
+    (``bot_identity``): ``a.py:X``, ``./a.py:X``, its absolute path, a symlink or a hard link
+    to it are one entrant, who would otherwise enter twice. Two files with the same bytes
+    (twins) are two entrants, and so are two classes of one file."""
+    seen = {}
+    for spec in specs:
+        identity, shown = bot_identity(spec)
+        if identity in seen:
+            raise BotLoadError(f"each bot may enter once: {seen[identity]!r} and {spec!r} are "
+                               f"the same bot ({shown})")
+        seen[identity] = spec
+
+
+def bot_identity(spec):
+    """``(identity, description)`` of the bot ``spec`` names, whatever its spelling: for a
+    bot from a file (a policy file, or a module found as a source file) the file itself, by
+    device and inode, and the class; otherwise its ``module:Class`` (a built-in name is its
+    module spelled out). Nothing is imported or run."""
+    if is_policy_file(spec):
+        path, class_name = spec, None
+    else:
+        where, class_name = _split(spec)
+        target = BUILTIN.get(spec, spec)
+        try:
+            path = where if _is_file_spec(where) else _module_source(target.rsplit(":", 1)[0])
+        except (ImportError, ValueError):
+            path = None
+        if path is None:
+            return ("module", target), target
+    try:
+        info = os.stat(path)
+    except (OSError, ValueError):
+        return ("path", os.path.abspath(path), class_name), absolute_spec(spec)
+    shown = f"file {os.path.realpath(path)!r}" + ("" if class_name is None
+                                                 else f", class {class_name!r}")
+    return ("file", info.st_dev, info.st_ino, class_name), shown
+
+
 def absolute_spec(spec):
     """``spec`` with a bot file's path made absolute (a bot's process starts elsewhere)."""
     if is_policy_file(spec):

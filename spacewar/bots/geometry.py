@@ -31,15 +31,15 @@ What is here:
   form), :func:`diamond_hits` and :func:`first_hit` (would a torpedo on this heading hit, by
   the game's diamond test), :func:`ram_escape`; :func:`warm_up` loads the compiled kernels.
 
-Importing this module loads the engine (numba), about a second in a fresh process: a bot that
-uses it pays that once, at start-up, within its start-up budget.
+Importing this module needs NumPy alone: a bot that uses these helpers starts as fast as one
+that does not (a confined bot's process is ready in a few tenths of a second). Only the
+prediction along a conic (:func:`predict_path` with a star, and what calls it) loads the
+engine's compiled Kepler solver, on its first call or at :func:`warm_up` (about a second in a
+fresh process, within a bot's start-up budget when its constructor calls ``warm_up``).
 """
 import math
 
 import numpy as np
-
-from engine import space
-from engine.analytic import kepler
 
 __all__ = [
     "SIDE", "TWO_PI", "wrap", "torus_delta", "torus_distance", "angle_diff", "bearing",
@@ -59,8 +59,10 @@ def wrap(x):
     """``x`` (a float or an array of coordinates) mapped onto the torus range [-0.5, 0.5):
     ``wrap(x) = x - floor(x + 1/2)`` (``engine.space.wrap`` with the game's side of 1).
 
-    ``wrap(0.7) == -0.3``; applied to a difference it gives the nearest image."""
-    return space.wrap(x, SIDE)
+    ``wrap(0.7) == -0.3``; applied to a difference it gives the nearest image. The same
+    operations as ``engine.space.wrap(x, 1.0)``, bit for bit (a test holds them to it),
+    written here so that a bot's helpers do not load the engine's compiled code."""
+    return x - SIDE * np.floor(x * (1.0 / SIDE) + 0.5)
 
 
 def torus_delta(a, b):
@@ -70,7 +72,7 @@ def torus_delta(a, b):
 
     Aim, distances and hits all use it: from (0.45, 0) the point (-0.45, 0) is 0.1 away
     to the right, ``torus_delta((0.45, 0), (-0.45, 0)) == (0.1, 0)``, not 0.9 to the left."""
-    return space.nearest_image(np.asarray(b, dtype=float) - np.asarray(a, dtype=float), SIDE)
+    return wrap(np.asarray(b, dtype=float) - np.asarray(a, dtype=float))
 
 
 def torus_distance(a, b):
@@ -245,6 +247,21 @@ def warm_up():
         _warm = True
 
 
+def _kepler():
+    """``engine.analytic.kepler``, imported on the first prediction: the engine's compiled
+    code is loaded by a bot that predicts along conics, not by every bot that imports this
+    module."""
+    global _KEPLER
+    if _KEPLER is None:
+        from engine.analytic import kepler
+
+        _KEPLER = kepler
+    return _KEPLER
+
+
+_KEPLER = None
+
+
 def predict_path(pos, vel, mu, times, capture=0.0):
     """Positions (len(times), 2) of a coasting ship, not wrapped onto the torus.
 
@@ -258,7 +275,7 @@ def predict_path(pos, vel, mu, times, capture=0.0):
     v = np.asarray(vel, dtype=float)
     if mu > 0.0 and (p[0] != 0.0 or p[1] != 0.0):
         v0 = v + 0.5 * star_accel(p, mu, capture)
-        path, _ = kepler(p, v0, mu, times)
+        path, _ = _kepler()(p, v0, mu, times)
         if np.all(np.isfinite(path)):
             return path
     return p + times[:, None] * v

@@ -144,3 +144,102 @@ class ThinksThenRaises(Steady):
         while time.perf_counter() < end:
             pass
         raise RuntimeError("thought for free")
+
+
+class _OwnAnswer(Steady):
+    """Answers a call with a CODES message of its own making (``forged``; None lets its host
+    answer honestly) and keeps its host's answer to that call off the wire: the answer pipe
+    then points, until its next call, at a pipe of its own that nobody reads."""
+
+    def __init__(self, seed=None):
+        super().__init__(seed)
+        self._wire = self._sink = self._drain = None
+
+    def forged(self, call, k):
+        return None
+
+    def act_batch(self, obs):
+        fd = _answer_fd()
+        if self._wire is None:
+            self._wire = os.dup(fd)
+            self._drain, self._sink = os.pipe()
+            os.set_blocking(self._drain, False)
+        os.dup2(self._wire, fd)  # the real answer pipe, for this call
+        try:
+            while os.read(self._drain, 1 << 16):  # what its host said last time: dropped
+                pass
+        except BlockingIOError:
+            pass
+        message = self.forged(self.calls, len(obs))
+        self.calls += 1
+        if message is not None:
+            os.write(fd, message)
+            os.dup2(self._sink, fd)  # its host's answer to this call goes nowhere
+        return np.full(len(obs), 4, dtype=np.int64)
+
+
+def _codes_message(call, status, codes):
+    return CODES.pack(b"SWC1", call, status, 0, 0, len(codes)) + bytes(codes)
+
+
+class NoCodes(_OwnAnswer):
+    """Status OK with no code at all, every call."""
+
+    act_batch = _OwnAnswer.act_batch  # in its body: it plays as a batch bot
+
+    def forged(self, call, k):
+        return _codes_message(call, 1, [])
+
+
+class OneCodeShort(_OwnAnswer):
+    """Status OK with K - 1 codes."""
+
+    act_batch = _OwnAnswer.act_batch  # in its body: it plays as a batch bot
+
+    def forged(self, call, k):
+        return _codes_message(call, 1, [4] * (k - 1))
+
+
+class OneCodeOver(_OwnAnswer):
+    """Status OK with K + 1 codes."""
+
+    act_batch = _OwnAnswer.act_batch  # in its body: it plays as a batch bot
+
+    def forged(self, call, k):
+        return _codes_message(call, 1, [4] * (k + 1))
+
+
+class RaisedWithCodes(_OwnAnswer):
+    """Says it raised, and sends K codes all the same."""
+
+    act_batch = _OwnAnswer.act_batch  # in its body: it plays as a batch bot
+
+    def forged(self, call, k):
+        return _codes_message(call, 2, [4] * k)
+
+
+class OneBadCode(_OwnAnswer):
+    """K codes on its first call, the last one out of range (200); honest afterwards."""
+
+    act_batch = _OwnAnswer.act_batch  # in its body: it plays as a batch bot
+
+    def forged(self, call, k):
+        return _codes_message(call, 1, [4] * (k - 1) + [200]) if call == 0 else None
+
+
+class IdlesAlone(Steady):
+    """Does nothing when asked for one match at a time (as ``spacewar check`` used to ask
+    every batch bot) and turns, thrusts and fires when asked for several (as a tournament
+    asks it): a check that asks it alone sees another bot than the tournament gets."""
+
+    def act_batch(self, obs):
+        if len(obs) == 1:
+            return np.full(1, 1, dtype=np.int64)  # no turn, nothing else: a no-op
+        return np.full(len(obs), 2 + 3 + 6, dtype=np.int64)  # turn, thrust, fire
+
+
+class FromTheClock(Steady):
+    """Turns one way or the other as the clock's nanoseconds say: never the same play twice."""
+
+    def act_batch(self, obs):
+        return np.array([time.perf_counter_ns() % 3 for _ in range(len(obs))], dtype=np.int64)

@@ -195,6 +195,30 @@ def test_importing_the_bots_package_does_not_load_the_engine():
     assert out == ["False", "False"]
 
 
+def test_importing_the_bot_helpers_and_the_chaser_does_not_load_the_engine():
+    """A bot built on the geometry helpers starts without numba (a confined process is ready
+    in tenths of a second); only a prediction along a conic loads the compiled Kepler solver."""
+    code = ("import sys, spacewar.bots.geometry as g, spacewar.bots.chaser\n"
+            "print('engine' in sys.modules, 'numba' in sys.modules)\n"
+            "g.predict_path([0.2, 0.1], [1e-4, 2e-4], 2.5e-7, [1.0, 2.0])\n"
+            "print('numba' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True, timeout=120).stdout.split()
+    assert out == ["False", "False", "True"]
+
+
+def test_the_helpers_wrap_is_the_engines_bit_for_bit():
+    from engine import space
+
+    rng = np.random.default_rng(5)
+    x = np.concatenate([rng.uniform(-3.0, 3.0, 10_000), [-0.5, 0.5, 0.49999999999999994,
+                                                          -0.5000000000000001, 1.5, -1.5, 0.0]])
+    np.testing.assert_array_equal(geometry.wrap(x), space.wrap(x, 1.0))
+    d = rng.uniform(-0.5, 0.5, (1000, 2)), rng.uniform(-0.5, 0.5, (1000, 2))
+    np.testing.assert_array_equal(geometry.torus_delta(*d), space.nearest_image(d[1] - d[0], 1.0))
+    assert geometry.wrap(0.7) == space.wrap(0.7, 1.0)
+
+
 # -- new-bot ----------------------------------------------------------------------------------
 def test_class_names_and_sources():
     assert [class_name_for(n) for n in ("hunter", "my_bot", "bot2", "_x", "_", "myBot")] == \
@@ -618,7 +642,11 @@ def test_play_match_with_bot_objects_returns_what_it_documents():
     assert result["seed"] == 7 and result["rounds_asked"] == 2 and result["rules"] == \
         SHORT.to_dict()
     assert replay["result"] == result and replay_io.check(replay)[0]
-    assert set(timing) == {"wall_seconds", "frames_per_second", "act", "act_seconds"}
+    assert set(timing) == {"wall_seconds", "frames_per_second", "startup_seconds",
+                           "play_seconds", "play_frames_per_second", "act", "act_seconds"}
+    assert 0 <= timing["startup_seconds"] <= timing["wall_seconds"]
+    assert timing["play_seconds"] <= timing["wall_seconds"] - timing["startup_seconds"] + 1e-9
+    assert timing["play_frames_per_second"] == result["steps"] / timing["play_seconds"]
     for seat in (0, 1):  # every frame asked both seats once
         assert timing["act"][seat]["count"] == result["steps"] == len(timing["act_seconds"][seat])
         assert timing["act"][seat]["max"] == timing["act_seconds"][seat].max()

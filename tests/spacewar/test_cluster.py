@@ -99,7 +99,9 @@ def test_module_bots_cannot_travel_and_forged_bytes_are_refused(tmp_path):
     with pytest.raises(BotLoadError, match="is a module"):
         cluster_play.bot_files(["chaser", "spacewar.bots.chaser:Chaser"])
     with pytest.raises(ValueError, match="do not match its sha256"):
-        cluster_play._materialise("bot.py", b"print('other code')", "0" * 64)
+        with cluster_play.private_copies({"bot.py:Bot": ("bot.py", b"print('other code')",
+                                                         "0" * 64)}):
+            pass
 
 
 def test_a_task_carries_only_the_files_of_its_own_bots():

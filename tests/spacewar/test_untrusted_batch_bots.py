@@ -9,10 +9,12 @@ import pytest
 
 from spacewar import Rules
 from spacewar.batch_match import batch_seed, play_matches
+from spacewar.checker import check_bot
 from spacewar.cli import main
 from spacewar.match import play_match
 from spacewar.seats import Limits
-from spacewar.tournament import _jobs, batch_files_of, run_tournament, schedule
+from spacewar.tournament import _jobs, batch_files_of, make_jobs, run_tournament, schedule
+from spacewar.tournament import _play as tournament_play
 
 from . import hostile_batch_bots  # the same classes, played as objects
 from .test_untrusted_bots import FAST, LONG, ROOMY, SHORT, nothing_left_running  # noqa: F401
@@ -105,6 +107,41 @@ def test_a_breach_or_a_death_forfeits_all_its_live_matches_and_no_other(bot, mes
     assert _same(results[2], honest)
 
 
+@pytest.mark.parametrize("bot, message", [
+    ("NoCodes", "answered 0 codes for a batch of 3 with status 'ok'"),
+    ("OneCodeShort", "answered 2 codes for a batch of 3 with status 'ok'"),
+    ("OneCodeOver", "answered 4 codes for a batch of 3 with status 'ok'"),
+    ("RaisedWithCodes", "answered 3 codes for a batch of 3 with status 'raised'"),
+])
+def test_a_count_of_codes_other_than_k_is_a_breach_that_forfeits_the_batch(bot, message):
+    """Found by a red team: status OK with no code was an invalid fault a match, not the
+    documented breach. Each bot answers every call itself (its host's answer never arrives),
+    so one breach is one fault and the forfeit of every live match at frame 0."""
+    results = [r for r, _ in play_matches(_jobs_with(f"{B}:{bot}"), rounds=1, rules=SHORT,
+                                          limits=ROOMY, max_faults=1000)]
+    for m, s in [(0, 0), (1, 1), (3, 0)]:
+        f = results[m]["faults"][s]
+        assert results[m]["forfeits"][s] and results[m]["winner_seat"] == 1 - s
+        assert f["invalid"] == f["total"] == 1 and results[m]["steps"] == 0, f
+        assert f["last"]["message"].startswith(f"broke the protocol: {message}"), f
+    honest = play_matches([("idle", "random", 3)], rounds=1, rules=SHORT)[0][0]
+    assert _same(results[2], honest)
+
+
+def test_k_codes_with_one_out_of_range_are_invalid_faults_and_play_goes_on():
+    results = [r for r, _ in play_matches(_jobs_with(f"{B}:OneBadCode"), rounds=1,
+                                          rules=SHORT, limits=ROOMY, max_faults=1000)]
+    honest = [r for r, _ in play_matches(_jobs_with(f"{B}:Steady"), rounds=1, rules=SHORT,
+                                         limits=ROOMY, max_faults=1000)]
+    for m, s in [(0, 0), (1, 1), (3, 0)]:
+        f = results[m]["faults"][s]
+        assert not any(results[m]["forfeits"]) and f["invalid"] == f["total"] == 1, f
+        assert f["last"] == {"frame": 0, "kind": "invalid",
+                             "message": "action code 200 out of range [0, 48)"}
+        assert results[m]["steps"] > 1 and honest[m]["faults"][s]["total"] == 0
+    assert _same(results[2], honest[2])
+
+
 def test_a_slow_batch_is_late_for_every_match_and_a_silent_one_is_stopped():
     slow = [r for r, _ in play_matches([(f"{B}:Slow", "idle", 1), ("idle", f"{B}:Slow", 2)],
                                        rounds=1, rules=SHORT, max_faults=3,
@@ -128,6 +165,37 @@ def test_a_confined_bot_saying_it_raised_is_still_charged_its_time():
     for s, r in enumerate(results):  # 0.4 s a call against 0.1 s of budget: its bank is spent
         f = r["faults"][s]
         assert r["forfeits"][s] and f["raised"] >= 1 and f["timeout"] >= 20, f
+
+
+def test_check_sees_a_batch_bot_play_as_a_tournament_plays_it():
+    """Found by a red team: ``spacewar check`` asked every batch bot with K = 1, which a
+    tournament never does against a built-in bot, so a bot could idle under check alone."""
+    spec = f"{B}:IdlesAlone"
+    seen = []
+    report = check_bot(spec, opponents=["chaser"], games=1, rules=SHORT, limits=ROOMY,
+                       on_match=seen.append)
+    matches = [(spec, "chaser", 0), ("chaser", spec, 0)]
+    job, = make_jobs(matches, 1, SHORT, ROOMY, 25, "auto", batch_files_of([spec]))
+    in_tournament = [r for r, _ in tournament_play(job)]  # the tournament's own path
+    checked = [m for m in seen if not m.get("repeat")]
+    assert len(checked) == len(report.matches) == 2
+    for record, result in zip(checked, in_tournament):
+        s = record["seat"]
+        assert record["frames"] == result["steps"]
+        assert record["score"] == [result["score"][s], result["score"][1 - s]]
+    alone = [play_match(p1, p2, seed=seed, rounds=1, rules=SHORT, limits=ROOMY)[0]
+             for p1, p2, seed in matches]  # asked alone, it idles: another play
+    assert [r["steps"] for r in alone] != [r["steps"] for r in in_tournament]
+    assert report.settings["together"] == [2] and report.deterministic is True
+
+
+def test_check_replays_a_batch_bot_s_whole_group_to_judge_its_determinism():
+    report = check_bot(f"{B}:FromTheClock", opponents=["idle"], games=2, rules=SHORT,
+                       limits=ROOMY)
+    assert report.deterministic is False and not report.passed
+    assert report.determinism.startswith("the 4 matches against idle (seeds 0 to 1, both "
+                                         "seats), played together twice: seed ")
+    assert "the first time" in report.determinism
 
 
 def test_a_bot_that_loses_act_batch_when_made_is_a_start_up_fault():

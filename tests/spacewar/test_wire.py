@@ -161,12 +161,24 @@ def test_batch_and_codes_messages_round_trip():
     (struct.pack("<4sqBBHI", b"SWC1", 1, wire.OK, 0, 0, 4) + bytes(4), "4 codes for a batch of 3"),
     (struct.pack("<4sqBBHI", b"SWC1", 1, 77, 0, 0, 3) + bytes(3), "unknown answer status 77"),
     (struct.pack("<4sqBBHI", b"SWC1", 1, wire.RAISED, 0, 5000, 0), "exceeds 1024"),
+    # a count of codes other than K with OK, none included, and codes with any other status
+    (wire.pack_codes(1, wire.OK, b""), "0 codes for a batch of 3 with status 'ok'"),
+    (wire.pack_codes(1, wire.OK, [0, 0]), "2 codes for a batch of 3"),
+    (wire.pack_codes(1, wire.RAISED, [0, 0, 0], "boom"), "3 codes for a batch of 3 with status "
+                                                         "'raised'"),
 ])
 def test_malformed_codes_are_wire_errors(data, message):
     reader = wire.AnswerReader(rows=3)
     with pytest.raises(wire.WireError, match=message):
         reader.feed(data)
         reader.next()
+
+
+def test_a_batch_answer_is_k_codes_with_ok_or_none_with_another_status():
+    reader = wire.AnswerReader(rows=3)
+    reader.feed(wire.pack_codes(4, wire.OK, [1, 2, 3]) + wire.pack_codes(5, wire.RAISED, b"", "x"))
+    assert reader.next() == (4, wire.OK, bytes([1, 2, 3]), "")
+    assert reader.next() == (5, wire.RAISED, b"", "x")
 
 
 def test_a_flood_of_codes_is_refused_before_it_is_parsed():
