@@ -29,6 +29,7 @@ from engine import cluster
 
 from . import confinement
 from .bots import BotLoadError, _is_file_spec, _split, is_builtin, is_policy_file
+from .seats import sweep_stale_directories
 
 #: the largest bot file sent to a cluster (a policy file included)
 MAX_BOT_BYTES = 64 << 20
@@ -88,7 +89,7 @@ def private_copies(files):
     if not files:  # built-in bots only: nothing to write
         yield {}
         return
-    _sweep_stale_copies()
+    sweep_stale_directories(COPIES_PREFIX)  # left by workers that were killed
     home = tempfile.mkdtemp(prefix=f"{COPIES_PREFIX}{os.getpid()}-")
     try:
         _open_to_the_bots_user(home)
@@ -119,29 +120,6 @@ def _open_to_the_bots_user(folder):
     match, which was told them, finds the files; otherwise ``folder`` stays 0o700."""
     if confinement.bot_uid() is not None:
         os.chmod(folder, 0o711)
-
-
-def _sweep_stale_copies():
-    """Remove the copies of tasks whose worker died without removing them (a worker killed by
-    SIGKILL): this user's directories named after a pid that no longer runs."""
-    base = tempfile.gettempdir()
-    try:
-        names = os.listdir(base)
-    except OSError:
-        return
-    for name in names:
-        pid = name[len(COPIES_PREFIX):].split("-", 1)[0]
-        if not name.startswith(COPIES_PREFIX) or not pid.isdigit() or int(pid) == os.getpid():
-            continue
-        path = os.path.join(base, name)
-        try:
-            if os.lstat(path).st_uid != os.geteuid():
-                continue  # another user's: not ours to judge
-            os.kill(int(pid), 0)
-        except ProcessLookupError:
-            shutil.rmtree(path, ignore_errors=True)
-        except OSError:
-            pass  # gone already, or a live process of another user
 
 
 def _named_by_seat(result, pair):

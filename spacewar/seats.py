@@ -669,23 +669,33 @@ _DIR_PREFIX = "spacewar-bot-"
 def _sweep_stale_directories():
     """Remove the directories of seats whose match process died without cleaning up (a match
     killed by SIGKILL leaves its bots' directories: they are named after its pid)."""
+    sweep_stale_directories(_DIR_PREFIX)
+
+
+def sweep_stale_directories(prefix):
+    """Remove this user's directories ``<tmp>/<prefix><pid>-*`` whose process ``pid`` no longer
+    runs (left by a process killed by SIGKILL, which cleans nothing up); another user's, or a
+    live process's, are left alone."""
     base = tempfile.gettempdir()
     try:
         names = os.listdir(base)
     except OSError:
         return
     for name in names:
-        if not name.startswith(_DIR_PREFIX):
+        if not name.startswith(prefix):
             continue
-        pid = name[len(_DIR_PREFIX):].split("-", 1)[0]
+        pid = name[len(prefix):].split("-", 1)[0]
         if not pid.isdigit() or int(pid) == os.getpid():
             continue
+        path = os.path.join(base, name)
         try:
+            if os.lstat(path).st_uid != os.geteuid():
+                continue  # another user's: not ours to judge
             os.kill(int(pid), 0)
         except ProcessLookupError:
-            shutil.rmtree(os.path.join(base, name), ignore_errors=True)
-        except PermissionError:
-            pass  # another user's live process
+            shutil.rmtree(path, ignore_errors=True)
+        except OSError:
+            pass  # gone already, or a live process of another user
 
 
 def _children(pid):

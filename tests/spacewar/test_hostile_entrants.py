@@ -5,6 +5,9 @@ under two spellings enters once; a submission's file name reaches the terminal e
 import hashlib
 import json
 import os
+import subprocess
+import sys
+import tempfile
 
 import pytest
 
@@ -279,3 +282,27 @@ def test_an_error_quoting_a_name_raw_is_shown_escaped(monkeypatch, capsys):
     monkeypatch.setitem(cli.COMMANDS, "bots", fails)
     assert main(["bots"]) == 2
     assert "evil\\x1b[2J.py cannot be played" in _no_raw_escape(capsys.readouterr().err)
+
+
+def test_directories_left_by_a_killed_process_are_swept_and_a_live_ones_kept(tmp_path,
+                                                                             monkeypatch):
+    """A seat's and a cluster task's directories are named after their process: one whose
+    process is gone (killed by SIGKILL, it cleaned nothing up) is removed by the next one,
+    a live process's is kept."""
+    from spacewar.seats import sweep_stale_directories
+
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    gone = subprocess.Popen([sys.executable, "-c", "pass"])
+    gone.wait()
+    live = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
+    try:
+        for pid in (gone.pid, live.pid, os.getpid()):
+            (tmp_path / f"some-prefix-{pid}-x1").mkdir()
+        (tmp_path / f"other-prefix-{gone.pid}-x1").mkdir()
+        sweep_stale_directories("some-prefix-")
+        assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
+            [f"some-prefix-{live.pid}-x1", f"some-prefix-{os.getpid()}-x1",
+             f"other-prefix-{gone.pid}-x1"])
+    finally:
+        live.kill()
+        live.wait()
