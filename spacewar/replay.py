@@ -273,6 +273,7 @@ def load(path):
     """
     shown = os.fspath(path) if isinstance(path, (str, bytes, os.PathLike)) else path
     raw = _read_replay_bytes(path, shown)
+    _check_structure(raw, shown)
     try:
         data = json.loads(raw, parse_constant=_reject_constant)
     except RecursionError:
@@ -308,6 +309,25 @@ def _read_replay_bytes(path, shown):
     if len(raw) > MAX_FILE_BYTES:
         raise ReplayError(f"{shown!r} is larger than {MAX_FILE_BYTES} bytes: not a replay")
     return raw
+
+
+#: the JSON values a replay may hold, bounded by counting the characters that open or
+#: separate them. A replay holds a few hundred (a 3-round match: 10 '[', 9 '{', 125 ','); its
+#: texts (fault messages, bots' output), where these characters may also stand, are capped at
+#: about 13,000 characters in all. A file of the same size made of tiny values parses into
+#: far more memory than its bytes: 60 MiB of '[],' is 21 million lists (+1.5 GiB measured).
+MAX_JSON_VALUES = 1 << 16
+
+
+def _check_structure(raw, shown):
+    """Refuse, before parsing, a file that could hold more than ``MAX_JSON_VALUES`` JSON
+    values: every value but the first follows a ',' or opens with '[' or '{', and counting
+    those bytes reads the file once, allocating nothing. The memory json.loads then takes
+    is about the file's bytes plus a few MiB."""
+    openers = raw.count(b"[") + raw.count(b"{") + raw.count(b",")
+    if openers > MAX_JSON_VALUES:
+        raise ReplayError(f"{shown!r} could hold {openers} JSON values, over the "
+                          f"{MAX_JSON_VALUES} a replay may have: not a replay")
 
 
 def _fail(source, message):

@@ -143,6 +143,49 @@ def test_a_device_or_an_oversized_replay_is_refused_before_it_is_read(tmp_path):
         replay.load(str(big))
 
 
+_REPLAY_CHILD = r"""
+import json, resource, sys
+from spacewar import replay
+
+def status(key):
+    with open("/proc/self/status") as f:
+        for line in f:
+            if line.startswith(key + ":"):
+                return int(line.split()[1]) * 1024
+
+limit = status("VmSize") + int(sys.argv[2])
+resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+before = status("VmRSS")
+report = {"error": None, "message": "", "memory_error": False}
+try:
+    replay.load(sys.argv[1])
+except BaseException as exc:
+    chain = [exc, exc.__cause__, exc.__context__]
+    report.update(error=type(exc).__name__, message=str(exc),
+                  memory_error=any(isinstance(e, MemoryError) for e in chain))
+report["growth"] = status("VmHWM") - before
+print(json.dumps(report))
+"""
+
+
+def test_a_replay_of_many_tiny_json_values_is_refused_before_it_is_parsed(tmp_path):
+    """60 MiB of '[],' inside a replay's JSON parse into 21 million lists (measured: +1.5 GiB
+    resident before the structure bound); it is refused by counting, with the memory of the
+    file's bytes alone."""
+    path = tmp_path / "lists.json"
+    count = 60 * MIB // 3
+    with open(path, "wb") as f:
+        f.write(b'{"format": "spacewar-replay", "actions": [' + b"[]," * (count - 1) + b"[]]}")
+    done = subprocess.run([sys.executable, "-c", _REPLAY_CHILD, str(path), str(CHILD_LIMIT)],
+                          capture_output=True, text=True, timeout=CHILD_TIMEOUT, cwd=ROOT)
+    assert done.returncode == 0, done.stderr[-2000:]
+    report = json.loads(done.stdout)
+    assert report["error"] == "ReplayError" and not report["memory_error"], report
+    assert f"could hold {2 * count + 2} JSON values, over the {replay.MAX_JSON_VALUES}" in \
+        report["message"]
+    assert report["growth"] <= 60 * MIB + 16 * MIB, report  # the bytes read, not a parse
+
+
 @pytest.fixture(scope="module")
 def recorded(tmp_path_factory):
     """A short match's replay (built-in bots, in this process)."""
