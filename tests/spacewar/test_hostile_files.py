@@ -23,12 +23,15 @@ CHILD_LIMIT = 512 * MIB
 #: a child that blocks is a failure, not a hang of the suite
 CHILD_TIMEOUT = 120
 
-# The child: imports first (the policy's validation imports numba), then the limit, then the
-# load. It prints what Policy.load raised, whether a MemoryError was behind it, and its peak.
+# The child: imports first (a policy's validation imports numba), then the limit, then the
+# load. It prints what the loader raised, whether a MemoryError was behind it, and its peak.
 _LOAD_CHILD = r"""
-import json, resource, sys
-import spacewar.learning
-from spacewar.policy import Policy
+import functools, importlib, json, resource, sys
+path, extra, loader, *preload = sys.argv[1:]
+for name in preload:
+    importlib.import_module(name)
+module, attribute = loader.split(":")
+load = functools.reduce(getattr, attribute.split("."), importlib.import_module(module))
 
 def status(key):
     with open("/proc/self/status") as f:
@@ -36,12 +39,12 @@ def status(key):
             if line.startswith(key + ":"):
                 return int(line.split()[1]) * 1024
 
-limit = status("VmSize") + int(sys.argv[2])
+limit = status("VmSize") + int(extra)
 resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
 before = status("VmRSS")
 report = {"error": None, "message": "", "memory_error": False}
 try:
-    Policy.load(sys.argv[1])
+    load(path)
 except BaseException as exc:
     chain = [exc, exc.__cause__, exc.__context__]
     report.update(error=type(exc).__name__, message=str(exc),
@@ -51,11 +54,13 @@ print(json.dumps(report))
 """
 
 
-def load_in_child(path):
-    """What ``Policy.load(path)`` did in a child under ``CHILD_LIMIT``: a dict with the
-    exception's name (``error``, None if it loaded), its ``message``, whether a MemoryError
-    was behind it and the peak resident memory ``growth`` in bytes over the load."""
-    done = subprocess.run([sys.executable, "-c", _LOAD_CHILD, str(path), str(CHILD_LIMIT)],
+def load_in_child(path, loader="spacewar.policy:Policy.load", preload=("spacewar.learning",)):
+    """What ``loader(path)`` did in a child under ``CHILD_LIMIT`` (``preload``: modules
+    imported before the limit): a dict with the exception's name (``error``, None if it
+    loaded), its ``message``, whether a MemoryError was behind it and the peak resident
+    memory ``growth`` in bytes over the load."""
+    done = subprocess.run([sys.executable, "-c", _LOAD_CHILD, str(path), str(CHILD_LIMIT),
+                           loader, *preload],
                           capture_output=True, text=True, timeout=CHILD_TIMEOUT, cwd=ROOT)
     assert done.returncode == 0, done.stderr[-2000:]
     return json.loads(done.stdout)
@@ -143,31 +148,6 @@ def test_a_device_or_an_oversized_replay_is_refused_before_it_is_read(tmp_path):
         replay.load(str(big))
 
 
-_REPLAY_CHILD = r"""
-import json, resource, sys
-from spacewar import replay
-
-def status(key):
-    with open("/proc/self/status") as f:
-        for line in f:
-            if line.startswith(key + ":"):
-                return int(line.split()[1]) * 1024
-
-limit = status("VmSize") + int(sys.argv[2])
-resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
-before = status("VmRSS")
-report = {"error": None, "message": "", "memory_error": False}
-try:
-    replay.load(sys.argv[1])
-except BaseException as exc:
-    chain = [exc, exc.__cause__, exc.__context__]
-    report.update(error=type(exc).__name__, message=str(exc),
-                  memory_error=any(isinstance(e, MemoryError) for e in chain))
-report["growth"] = status("VmHWM") - before
-print(json.dumps(report))
-"""
-
-
 def test_a_replay_of_many_tiny_json_values_is_refused_before_it_is_parsed(tmp_path):
     """60 MiB of '[],' inside a replay's JSON parse into 21 million lists (measured: +1.5 GiB
     resident before the structure bound); it is refused by counting, with the memory of the
@@ -176,10 +156,7 @@ def test_a_replay_of_many_tiny_json_values_is_refused_before_it_is_parsed(tmp_pa
     count = 60 * MIB // 3
     with open(path, "wb") as f:
         f.write(b'{"format": "spacewar-replay", "actions": [' + b"[]," * (count - 1) + b"[]]}")
-    done = subprocess.run([sys.executable, "-c", _REPLAY_CHILD, str(path), str(CHILD_LIMIT)],
-                          capture_output=True, text=True, timeout=CHILD_TIMEOUT, cwd=ROOT)
-    assert done.returncode == 0, done.stderr[-2000:]
-    report = json.loads(done.stdout)
+    report = load_in_child(path, "spacewar.replay:load", preload=())
     assert report["error"] == "ReplayError" and not report["memory_error"], report
     assert f"could hold {2 * count + 2} JSON values, over the {replay.MAX_JSON_VALUES}" in \
         report["message"]
