@@ -226,17 +226,17 @@ def _plays_together(bot, batch_files, isolation):
 
 
 def _jobs(bot, opponents, games, seed, isolation, batch_files):
-    """The schedule cut as a tournament cuts its own (``tournament._jobs``): a list of
+    """The schedule cut as a tournament cuts its own (``tournament.group_jobs``): a list of
     ``(entries, together)``, ``entries`` the ``(opponent, seed, seat)`` of each match of a
     job, ``together`` whether they are played in one game (``batch_match.play_matches``)."""
-    from .tournament import _jobs as tournament_jobs
+    from .tournament import group_jobs
 
     schedule = _schedule(opponents, games, seed)
     if not isinstance(bot, str):
         return [([entry], False) for entry in schedule]
     matches = [(*_seated(bot, opponent, seat), s) for opponent, s, seat in schedule]
     jobs, start = [], 0
-    for job, together in tournament_jobs(matches, isolation, batch_files):
+    for job, together in group_jobs(matches, isolation, batch_files):
         jobs.append((schedule[start:start + len(job)], together))
         start += len(job)
     return jobs

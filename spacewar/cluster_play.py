@@ -22,7 +22,6 @@ import contextlib
 import hashlib
 import os
 import shutil
-import stat
 import tempfile
 
 from engine import cluster
@@ -30,6 +29,7 @@ from engine import cluster
 from . import confinement
 from .bots import BotLoadError, _is_file_spec, _split, is_builtin, is_policy_file
 from .seats import sweep_stale_directories
+from .strangers_files import FileRefused, read_bounded
 
 #: the largest bot file sent to a cluster (a policy file included)
 MAX_BOT_BYTES = 64 << 20
@@ -60,15 +60,12 @@ def bot_files(bots):
 def _read_bot_file(path):
     """The bytes of the bot file ``path``: a regular file (opened non-blocking, so a FIFO is
     refused, not waited on) of at most ``MAX_BOT_BYTES``, read no further than that."""
-    fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_CLOEXEC)
-    with os.fdopen(fd, "rb") as f:
-        if not stat.S_ISREG(os.fstat(fd).st_mode):
-            raise BotLoadError(f"bot file {path!r} is not a regular file")
-        data = f.read(MAX_BOT_BYTES + 1)
-    if len(data) > MAX_BOT_BYTES:
-        raise BotLoadError(f"bot file {path!r} is more than the {MAX_BOT_BYTES} bytes a "
-                           "cluster run sends")
-    return data
+    try:
+        return read_bounded(path, MAX_BOT_BYTES)
+    except FileRefused as exc:
+        raise BotLoadError(f"bot file {path!r} is not a regular file" if exc.reason ==
+                           "not regular" else f"bot file {path!r} is more than the "
+                           f"{MAX_BOT_BYTES} bytes a cluster run sends") from None
 
 
 #: the start of the name of a task's private directory of bot copies (then the worker's pid)

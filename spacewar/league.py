@@ -42,13 +42,13 @@ import dataclasses
 import json
 import os
 import reprlib
-import stat
 
 import numpy as np
 
 from .match import DEFAULT_BUDGET, DEFAULT_MAX_FAULTS
 from .rules import Rules
 from .seats import Limits, printable
+from .strangers_files import FileRefused, read_bounded
 from .tournament import MatchRunner, _progress, batch_files_of, make_jobs, match_record
 
 FORMAT = "spacewar-league"
@@ -294,36 +294,20 @@ def _read_bounded(path, limit, rounds):
     """The bytes of the results file at ``path`` (``b""`` when there is none): a regular file
     (never a FIFO or device, which could block or never end), opened without blocking, of at
     most ``limit`` bytes (what ``rounds`` rounds can take), read from the descriptor that was
-    checked."""
+    checked (``strangers_files.read_bounded``)."""
     too_big = (f"over the {limit} a results file may have" if rounds is None else
                f"over the {limit} that {rounds} rounds of this league can take (if it holds "
                "more rounds, ask for as many)")
     try:
-        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+        return read_bounded(path, limit)
     except FileNotFoundError:
         return b""
+    except FileRefused as exc:
+        _fail(path, {"not regular": "it is not a regular file",
+                     "too large": f"it has {exc.size} bytes, {too_big}",
+                     "grew": f"it grew while it was read, {too_big}"}[exc.reason])
     except OSError as exc:
         _fail(path, f"cannot read it: {exc.strerror or exc}")
-    try:
-        info = os.fstat(fd)
-        if not stat.S_ISREG(info.st_mode):
-            _fail(path, "it is not a regular file")
-        if info.st_size > limit:
-            _fail(path, f"it has {info.st_size} bytes, {too_big}")
-        chunks, left = [], limit + 1
-        while left > 0:
-            chunk = os.read(fd, min(left, 1 << 20))
-            if not chunk:
-                break
-            chunks.append(chunk)
-            left -= len(chunk)
-        if left <= 0:
-            _fail(path, f"it grew while it was read, {too_big}")
-        return b"".join(chunks)
-    except OSError as exc:
-        _fail(path, f"cannot read it: {exc.strerror or exc}")
-    finally:
-        os.close(fd)
 
 
 def _finite_float(text):

@@ -43,12 +43,12 @@ import json
 import math
 import os
 import re
-import stat
 import zipfile
 
 import numpy as np
 
 from .codes import codes_from_parts
+from .strangers_files import FileRefused, read_bounded
 
 FORMAT = "spacewar-policy"
 FORMAT_VERSION = 1
@@ -167,37 +167,18 @@ LOAD_MEMORY_BOUND = MAX_FILE_BYTES + MAX_ARRAY_BYTES + MAX_ARRAY_BYTES // 4 + (1
 def read_policy_bytes(path, where):
     """The bytes of the policy file at ``path``: a regular file (never a FIFO or device,
     which could block or never end), opened without blocking, of at most ``MAX_FILE_BYTES``,
-    read from the descriptor that was checked."""
+    read from the descriptor that was checked (``strangers_files.read_bounded``)."""
     try:
-        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+        return read_bounded(path, MAX_FILE_BYTES)
+    except FileRefused as exc:
+        raise PolicyError({
+            "not regular": f"{where} is not a regular file",
+            "too large": f"{where} has {exc.size} bytes, over the {MAX_FILE_BYTES} a policy "
+                         "file may have",
+            "grew": f"{where} grew past the {MAX_FILE_BYTES} bytes a policy file may have "
+                    "while it was read"}[exc.reason]) from None
     except OSError as exc:
         raise PolicyError(f"cannot read {where}: {exc.strerror or exc}") from None
-    try:
-        info = os.fstat(fd)
-        if not stat.S_ISREG(info.st_mode):
-            raise PolicyError(f"{where} is not a regular file")
-        if info.st_size > MAX_FILE_BYTES:
-            raise PolicyError(f"{where} has {info.st_size} bytes, over the {MAX_FILE_BYTES} a "
-                              "policy file may have")
-        # one read of the whole file (then b"".join returns that very object: the bytes are
-        # held once, not twice); more reads only if it grows meanwhile
-        chunks, left = [], MAX_FILE_BYTES + 1
-        size = info.st_size + 1
-        while left > 0:
-            chunk = os.read(fd, min(left, size))
-            size = 1 << 20
-            if not chunk:
-                break
-            chunks.append(chunk)
-            left -= len(chunk)
-        if left <= 0:
-            raise PolicyError(f"{where} grew past the {MAX_FILE_BYTES} bytes a policy file may "
-                              "have while it was read")
-        return b"".join(chunks)
-    except OSError as exc:
-        raise PolicyError(f"cannot read {where}: {exc.strerror or exc}") from None
-    finally:
-        os.close(fd)
 
 
 def _read_npz(data, where):

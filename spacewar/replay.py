@@ -29,7 +29,6 @@ import json
 import math
 import os
 import secrets
-import stat
 
 import numpy as np
 
@@ -39,6 +38,7 @@ from . import core
 from .game import Game
 from .rules import Rules
 from .seats import FAULT_KINDS
+from .strangers_files import FileRefused, read_bounded
 
 FORMAT = "spacewar-replay"
 VERSION = 2
@@ -289,26 +289,17 @@ def _read_replay_bytes(path, shown):
     descriptor it is then read from, of at most ``MAX_FILE_BYTES`` (a replay holds about 6
     bytes a frame: 64 MiB is over 10 million frames, far beyond any match)."""
     try:
-        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+        return read_bounded(path, MAX_FILE_BYTES)
+    except FileRefused as exc:
+        raise ReplayError({
+            "not regular": f"cannot read replay {shown!r}: not a regular file (a replay is a "
+                           "JSON file; pipes and devices are refused)",
+            "too large": f"{shown!r} has {exc.size} bytes, over the {MAX_FILE_BYTES} a replay "
+                         "may have: not a replay",
+            "grew": f"{shown!r} is larger than {MAX_FILE_BYTES} bytes: not a replay",
+        }[exc.reason]) from None
     except (OSError, TypeError, ValueError) as exc:
         raise ReplayError(f"cannot read replay {shown!r}: {exc}") from None
-    try:
-        info = os.fstat(fd)
-        if not stat.S_ISREG(info.st_mode):
-            raise ReplayError(f"cannot read replay {shown!r}: not a regular file (a replay is "
-                              "a JSON file; pipes and devices are refused)")
-        if info.st_size > MAX_FILE_BYTES:
-            raise ReplayError(f"{shown!r} has {info.st_size} bytes, over the {MAX_FILE_BYTES} "
-                              "a replay may have: not a replay")
-        with os.fdopen(fd, "rb", closefd=False) as f:
-            raw = f.read(MAX_FILE_BYTES + 1)
-    except OSError as exc:
-        raise ReplayError(f"cannot read replay {shown!r}: {exc}") from None
-    finally:
-        os.close(fd)
-    if len(raw) > MAX_FILE_BYTES:
-        raise ReplayError(f"{shown!r} is larger than {MAX_FILE_BYTES} bytes: not a replay")
-    return raw
 
 
 #: the JSON values a replay may hold, bounded by counting the characters that open or

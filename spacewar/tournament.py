@@ -63,7 +63,7 @@ def batch_files_of(bots):
     return frozenset(spec for spec in bots if declares_act_batch(spec))
 
 
-def _jobs(schedule_, isolation, batch_files=frozenset()):
+def group_jobs(schedule_, isolation, batch_files=frozenset()):
     """The schedule cut into jobs ``(matches, together)``: each match alone, except that a
     pairing with a batch bot (a policy file, or a bot from a file in ``batch_files``) and a
     bot that can share its game (``batch_match.can_play_together``) is one job, all its
@@ -175,10 +175,11 @@ def run_tournament(bots, games=10, seed=1, rounds=3, rules=None, workers=None, p
 
 
 def make_jobs(schedule_, rounds, rules, limits, max_faults, isolation, batch_files):
-    """The work of a schedule: ``_jobs``' matches with everything a worker needs to play them."""
+    """The work of a schedule: ``group_jobs``' matches with everything a worker needs to
+    play them."""
     return [(matches, together, rounds, rules.to_dict(), limits, max_faults, isolation,
              batch_files)
-            for matches, together in _jobs(schedule_, isolation, batch_files)]
+            for matches, together in group_jobs(schedule_, isolation, batch_files)]
 
 
 class MatchRunner:

@@ -13,7 +13,7 @@ from spacewar.checker import check_bot
 from spacewar.cli import main
 from spacewar.match import play_match
 from spacewar.seats import Limits
-from spacewar.tournament import _jobs, batch_files_of, make_jobs, run_tournament, schedule
+from spacewar.tournament import batch_files_of, group_jobs, make_jobs, run_tournament, schedule
 from spacewar.tournament import _play as tournament_play
 
 from . import hostile_batch_bots  # the same classes, played as objects
@@ -56,7 +56,7 @@ def test_a_batch_bot_from_a_file_answers_for_all_its_matches_in_one_process():
 def test_a_tournament_plays_a_batch_bot_s_pairings_together_with_the_same_table():
     bots = [f"{B}:Steady", "idle", "random"]
     assert batch_files_of(bots) == {f"{B}:Steady"}
-    jobs = _jobs(schedule(bots, 2, 1), "auto", batch_files_of(bots))
+    jobs = group_jobs(schedule(bots, 2, 1), "auto", batch_files_of(bots))
     assert [(len(m), t) for m, t in jobs] == [(4, True), (4, True)] + [(1, False)] * 4
     runs = [run_tournament(bots, games=2, seed=1, rounds=1, rules=SHORT, workers=w,
                            progress=False, limits=ROOMY)[0] for w in (1, 2)]
