@@ -8,19 +8,16 @@
     sim.add_force(forces.UniformGravity(g=(0.0, -1.0)))
     sim.step(7)
 """
-from .cache import project_cache
-
-with project_cache("engine"):
-    from . import analytic, atomic, cache, clock, diagnostics, forces, integrators, space, state
-    from . import stability
-    from .batch import Batch
-    from .atomic import OutputPathError, atomic_write, check_output_dir, check_output_path
-    from .clock import FixedStepClock
-    from .errors import SimulationError
-    from .integrators import ADAPTIVE_INTEGRATORS, INTEGRATORS, ORDERS, SYMPLECTIC
-    from .simulation import Simulation
-    from . import advisor
-    from .advisor import advise
+from . import analytic, atomic, cache, clock, diagnostics, forces, integrators, space, state
+from . import stability
+from .batch import Batch
+from .atomic import OutputPathError, atomic_write, check_output_dir, check_output_path
+from .clock import FixedStepClock
+from .errors import SimulationError
+from .integrators import ADAPTIVE_INTEGRATORS, INTEGRATORS, ORDERS, SYMPLECTIC
+from .simulation import Simulation
+from . import advisor
+from .advisor import advise
 
 __version__ = "0.1.0"
 

@@ -6,6 +6,10 @@ and its position error against the closed-form solution (``engine.analytic.keple
 
 ``python -m engine cloth [--out cloth.gif] [--frames N] ...``: a pinned cloth in the wind and a
 rope beside it, drawn to a GIF (``engine.cloth_demo``; needs the ``[viz]`` extra).
+
+``python -m engine compile [--jobs N] [--list]``: compile the tour's integrators, every force
+kernel and ``Batch``'s executors ahead, one worker process per core (``engine.compile_ahead``).
+The tour itself compiles its integrators so on its first run.
 """
 import argparse
 import math
@@ -13,7 +17,7 @@ import time
 
 import numpy as np
 
-from . import INTEGRATORS, Simulation, analytic, cloth_demo, forces
+from . import INTEGRATORS, Simulation, analytic, cloth_demo, compile_ahead, forces
 from .integrators import FORCE_EVALUATIONS, ORDERS
 
 
@@ -40,26 +44,46 @@ def kepler_run(integrator, orbits, evaluations_per_orbit, e=0.6):
     }
 
 
+def first_runs(*integrators):
+    """A short first run of each integrator (its code compiled, or loaded from the cache): the
+    tour's tasks of ``engine.compile_ahead``."""
+    for name in integrators:
+        kepler_run(name, 1, 40)
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="python -m engine", description=__doc__.split("\n\n")[0])
     parser.add_argument("--orbits", type=int, default=100)
     parser.add_argument("--evaluations", type=int, default=400,
                         help="force evaluations per orbit for the fixed-step methods")
-    commands = parser.add_subparsers(dest="command", metavar="{cloth}",
-                                     help="cloth: the cloth-and-rope GIF demo (without a "
-                                          "command: the Kepler tour)")
+    commands = parser.add_subparsers(dest="command", metavar="{cloth,compile}",
+                                     help="cloth: the cloth-and-rope GIF demo; compile: the "
+                                          "tour's kernels compiled ahead, on every core "
+                                          "(without a command: the Kepler tour)")
     cloth = commands.add_parser("cloth", help="a pinned cloth in the wind and a rope, to a GIF",
                                 description=cloth_demo.__doc__.split("\n\n")[0])
     cloth_demo.add_arguments(cloth)
+    ahead = commands.add_parser("compile", help="compile the engine's kernels ahead, on every core",
+                                description=compile_ahead.__doc__.split("\n\n")[0])
+    compile_ahead.add_arguments(ahead)
     args = parser.parse_args(argv)
     if args.command == "cloth":
         cloth_demo.main(args, cloth)
         return
+    if args.command == "compile":
+        compile_ahead.main(args, compile_ahead.ENGINE)
+        return
+    # a first run compiles the integrators on every core at once (nothing when warm)
+    compiled = compile_ahead.run(compile_ahead.TOUR)
+    if compiled:
+        print(f"(first run: {len(compiled)} groups of integrators compiled ahead in "
+              f"{min(compile_ahead.default_jobs(), len(compiled))} processes, "
+              f"{sum(compiled.values()):.0f} s of compiling in all)")
     print(f"Kepler problem, e = 0.6, {args.orbits} orbits, "
           f"{args.evaluations} force evaluations per orbit (rk45: tolerance 1e-10)")
     print(f"{'integrator':<17}{'order':>5}{'steps':>10}{'|dE/E|':>11}{'|r - r_exact|':>15}{'time':>10}")
     for name in INTEGRATORS:
-        kepler_run(name, 1, 40)  # load the compiled code first: time the integration only
+        first_runs(name)  # load the compiled code first: time the integration only
         row = kepler_run(name, args.orbits, args.evaluations)
         print(f"{name:<17}{row['order']:>5}{row['steps']:>10}{row['energy_error']:>11.2e}"
               f"{row['position_error']:>15.2e}{row['seconds'] * 1e3:>8.1f}ms")

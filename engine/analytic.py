@@ -58,7 +58,7 @@ import math
 from collections import namedtuple
 
 import numpy as np
-from numba import njit
+from .cache import jit
 
 from ._validate import finite_array, nonnegative_float, positive_float, vector
 
@@ -113,14 +113,14 @@ _RESIDUAL_RTOL = 4.0 * 2.220446049250313e-16
 # rounding.  No FMA is needed, which keeps this portable under numba.
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _two_sum(a, b):
     s = a + b
     bb = s - a
     return s, (a - (s - bb)) + (b - bb)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _two_prod(a, b):
     p = a * b
     c = 134217729.0 * a  # 2^27 + 1: Dekker's splitter for doubles
@@ -132,7 +132,7 @@ def _two_prod(a, b):
     return p, ((ah * bh - p) + ah * bl + al * bh) + al * bl
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def _state_scalars(r0, v0, mu):
     """``(|r0|, |v0|^2, r0.v0, alpha)`` with alpha = 2/|r0| - |v0|^2/mu
     accurate to a few ulps (double-double intermediates)."""
@@ -171,7 +171,7 @@ def _state_scalars(r0, v0, mu):
     return sh, vh + vl, dh + dl, alpha
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def stumpff(z):
     """Stumpff functions c0(z), c1(z), c2(z), c3(z).
 
@@ -210,7 +210,7 @@ def stumpff(z):
     return math.cosh(x), sh / x, 2.0 * hh * hh / (-z), (sh - x) / (-z * x)
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def _universal_functions(chi, alpha):
     """Battin's U0..U3 for universal anomaly ``chi`` and ``alpha = 1/a``."""
     chi2 = chi * chi
@@ -218,7 +218,7 @@ def _universal_functions(chi, alpha):
     return c0, chi * c1, chi2 * c2, chi2 * chi * c3
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def _kepler_residual(y, r0n, sig, alpha, target):
     """Residual G of Kepler's equation at chi = y, its derivative r, and the
     rounding-noise level of G (eps times the sum of its terms' magnitudes)."""
@@ -231,7 +231,7 @@ def _kepler_residual(y, r0n, sig, alpha, target):
     return G, r, noise
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def universal_anomaly(r0n, sigma0, alpha, tau):
     """Solve the universal Kepler equation for the universal anomaly chi.
 
@@ -365,7 +365,7 @@ def universal_anomaly(r0n, sigma0, alpha, tau):
     return d * y
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def lagrange_coefficients(r0, v0, mu, t):
     """Lagrange f, g, fdot, gdot mapping (r0, v0) to the state at time t.
 
@@ -421,7 +421,7 @@ def lagrange_coefficients(r0, v0, mu, t):
 _FAR_FROM_PERIAPSIS = 2.0
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def kepler_step(r0, v0, mu, t, r_out, v_out):
     """Advance a Kepler state by ``t`` and write it to ``r_out``, ``v_out``.
 
@@ -541,7 +541,7 @@ def kepler_step(r0, v0, mu, t, r_out, v_out):
         v_out[i] = fdot * ri + gdot * vi
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def kepler_propagate(r0, v0, mu, t):
     """Compiled ``kepler`` for a scalar time: returns new arrays ``(r, v)``."""
     r = np.empty(r0.shape[0])
@@ -550,7 +550,7 @@ def kepler_propagate(r0, v0, mu, t):
     return r, v
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def kepler_propagate_times(r0, v0, mu, times):
     """Compiled ``kepler`` for many times: arrays ``(R, V)`` of shape (n, dim).
 
@@ -566,7 +566,7 @@ def kepler_propagate_times(r0, v0, mu, times):
     return R, V
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def orbit_invariants(r0, v0, mu):
     """Conic invariants ``(a, e, energy, period, h, p, periapsis)``.
 
@@ -608,7 +608,7 @@ def orbit_invariants(r0, v0, mu):
     return a, e, energy, period, h, p, p / (1.0 + e)
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def oscillator_transition(omega, zeta, t):
     """State-transition coefficients of ``x'' + 2 zeta omega x' + omega^2 x = 0``.
 
@@ -652,7 +652,7 @@ def oscillator_transition(omega, zeta, t):
     return EC + zw * ES, ES, -omega * omega * ES, EC - zw * ES
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def ballistic_step(p0, v0, g, t, p_out, v_out):
     """Compiled ``ballistic`` for one time; ``p_out``/``v_out`` may alias inputs."""
     half_tt = 0.5 * t * t

@@ -31,7 +31,9 @@ named tuples, and ``advance_system`` steps it with a splitting scheme.
 import numbers
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
+
+from .cache import jit
 
 from . import diagnostics
 from . import integrators as _integrators
@@ -53,20 +55,21 @@ SPLITTING, EULER, RK4, RK45 = 0, 1, 2, 3
 MAX_SYSTEMS = 2 ** 24
 
 
-@njit(cache=True, inline="always")
+@jit(inline="always")
 def system_state(state, m):
     """System m of a batch's state (views of its rows), as a one-system ``State``."""
     return State(state.pos[m], state.vel[m], state.mass[m], state.charge[m], state.radius[m],
                  state.active[m], state.test[m], state.pinned[m], state.n, state.box)
 
 
-@njit(cache=True, inline="always")
+@jit(inline="always")
 def system_model(model, m):
     """System m's force terms: the shared tables with its own row of float parameters."""
-    return Model(model.kinds, model.params[m], model.param_offsets, model.indices, model.index_offsets)
+    return Model(model.kinds, model.params[m], model.param_offsets, model.indices,
+                 model.index_offsets, model.accumulators, model.potentials)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def advance_system(m, t, h, steps, state, model, work, vdep, drifts, kicks):
     """``steps`` steps of a splitting scheme (``splitting.coefficients(name)``) on system m
     of a batch: the per-system kernel for compiled callers. Returns ``(t, h, done, status)``
@@ -75,7 +78,7 @@ def advance_system(m, t, h, steps, state, model, work, vdep, drifts, kicks):
                              vdep, np.nan, drifts, kicks)
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def step_system(m, family, t, h, steps, state, model, work, vdep, tol, drifts, kicks):
     """System m advanced by the integrator ``family`` (SPLITTING with its coefficients,
     EULER, RK4 or RK45 with tolerance ``tol``): exactly what ``Simulation.step`` runs."""
@@ -90,7 +93,7 @@ def step_system(m, family, t, h, steps, state, model, work, vdep, tol, drifts, k
     return dormand_prince.advance(t, h, steps, s, model_m, work, vdep, np.nan, tol)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _workspace(n):
     """The scratch a ``Simulation`` of n slots would get, kept on this thread."""
     if n >= PARALLEL_MIN:
@@ -102,7 +105,7 @@ def _workspace(n):
 CHUNKS = 256
 
 
-@njit(parallel=True, cache=True, error_model="numpy")
+@jit(parallel=True, error_model="numpy")
 def advance_all(family, t, h, steps, state, model, vdep, tol, drifts, kicks, done, status):
     """Every system by ``steps`` steps, whole systems spread over the threads in chunks (each
     chunk with its own scratch space; which thread runs a chunk changes no result).
@@ -122,7 +125,7 @@ def advance_all(family, t, h, steps, state, model, vdep, tol, drifts, kicks, don
             status[m] = sm
 
 
-@njit(parallel=True, cache=True, error_model="numpy")
+@jit(parallel=True, error_model="numpy")
 def first_invalid(state, found):
     """``engine.state.first_invalid`` of every system into ``found`` (0 where valid), which
     also sets pinned particles' velocities back to zero."""
@@ -130,7 +133,7 @@ def first_invalid(state, found):
         found[m] = first_invalid_in(system_state(state, m))
 
 
-@njit(parallel=True, cache=True, error_model="numpy")
+@jit(parallel=True, error_model="numpy")
 def energies(t, state, model, moving, terms, kinetic, potential):
     """Kinetic and potential energy of every system (the diagnostics of a ``Simulation``)."""
     for m in prange(state.pos.shape[0]):
@@ -144,7 +147,7 @@ def energies(t, state, model, moving, terms, kinetic, potential):
         potential[m] = total
 
 
-@njit(parallel=True, cache=True, error_model="numpy")
+@jit(parallel=True, error_model="numpy")
 def momenta(state, moving, out):
     """Linear momentum of every system (``diagnostics.momentum`` per system)."""
     for m in prange(state.pos.shape[0]):
@@ -460,7 +463,7 @@ class Batch(DeclaresTerms):
             else:  # pragma: no cover - no declared layout changes any other way
                 raise ValueError(f"{type(term).__name__}.{name} was set per system with shape "
                                  f"{old_shape}, and it now has shape {shape}")
-        self._model = Model(model.kinds, rows, model.param_offsets, model.indices, model.index_offsets)
+        self._model = model._replace(params=rows)
         self._layouts = {k: layout for k, layout in enumerate(layouts)}
         self._layout_terms = list(self._forces)
         self._model_key = key

@@ -7,10 +7,10 @@ The potential energy is the sum of the declared conservative force terms' potent
 angular momentum is the scalar z component.
 """
 import numpy as np
-from numba import njit
+from .cache import jit
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def kinetic_energy(vel, mass, active, n):
     e = 0.0
     for i in range(n):
@@ -22,7 +22,7 @@ def kinetic_energy(vel, mass, active, n):
     return e
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def momentum(vel, mass, active, n):
     p = np.zeros(vel.shape[0])
     for i in range(n):
@@ -32,7 +32,7 @@ def momentum(vel, mass, active, n):
     return p
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def angular_momentum(pos, vel, mass, active, n):
     """L about the origin: shape (3,) in 3-D; in 2-D a length-1 array holding L_z."""
     dim = pos.shape[0]
@@ -50,7 +50,7 @@ def angular_momentum(pos, vel, mass, active, n):
     return out
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def center_of_mass(pos, vel, mass, active, n):
     """(position, velocity) of the centre of mass of the active particles."""
     dim = pos.shape[0]

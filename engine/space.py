@@ -16,7 +16,7 @@ With ``L = 0`` (open space) both return their argument unchanged. ``wrap`` and
 float precision) or ``wrap_scalar`` (float64), the same formula.
 """
 import numpy as np
-from numba import njit
+from .cache import jit
 
 from ._validate import nonnegative_float, optional
 
@@ -37,7 +37,7 @@ def nearest_image(d, side):
     return wrap(d, side)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def period_shift(x, side, half):
     """The whole periods ``side * floor(x * (1 / side) + 1/2)`` that ``wrap`` takes off ``x``
     (``side`` > 0; ``half`` is 1/2 in the precision of ``x``). A multiplication by the
@@ -46,7 +46,7 @@ def period_shift(x, side, half):
     return side * np.floor(x * ((half + half) / side) + half)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def image(x, side, half):
     """``wrap`` for one number, inlined into compiled callers (the drift, the pair loops).
 
@@ -56,7 +56,7 @@ def image(x, side, half):
     return x
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def wrap_scalar(x, side):
     """``wrap`` for one float64, inlined into compiled callers."""
     return image(x, side, 0.5)

@@ -79,7 +79,7 @@ import math
 from collections import namedtuple
 
 import numpy as np
-from numba import njit
+from .cache import jit
 
 from .forces import gravity as _gravity
 from .forces import point_mass as _point_mass
@@ -215,7 +215,7 @@ def step_limits():
 
 # -- the spring network ------------------------------------------------------------------------
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def _spring_blocks(pos, active, box, params, f0, indices, i0, i1, out_a, out_b, out_h,
                    start):
     """The Hessian blocks H of one Springs term's springs with both ends active, written from
@@ -256,7 +256,7 @@ def _spring_blocks(pos, active, box, params, f0, indices, i0, i1, out_a, out_b, 
     return row
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def _apply(pa, pb, h, scale, x, y):
     """y = A x with A = M^-1/2 K M^-1/2 (``scale`` = 1/sqrt(m) on moving particles, else 0)."""
     dim = x.shape[0]
@@ -279,7 +279,7 @@ def _apply(pa, pb, h, scale, x, y):
             y[p, b] += sb * w
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def _power(pa, pb, h, scale, x, shift, tol, min_iter, max_iter):
     """Power iteration on A + shift I from x: ``(rho, missing, iterations, converged)``."""
     dim, n = x.shape
@@ -388,7 +388,7 @@ def _scale(state):
     return scale
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def _massless_spring(pa, pb, h, moving, mass):
     """True if a moving massless particle hangs on a spring of non-zero stiffness."""
     for s in range(pa.shape[0]):
@@ -433,7 +433,7 @@ def spring_frequency(sim, tol=TOLERANCE, max_iterations=MAX_ITERATIONS):
 
 # -- gravity near close pairs ------------------------------------------------------------------
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _pair_rate(C, r2, eps2):
     """Spectral radius of a softened pair's Hessian per unit of C = G M: C max(1,
     |eps^2 - 2 r^2| / s^2) / s^3, s^2 = r^2 + eps^2 (2 C / r^3 without softening)."""
@@ -444,7 +444,7 @@ def _pair_rate(C, r2, eps2):
     return C * max(1.0, along) / (s2 * math.sqrt(s2))
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def _gravity_rate(pos, mass, active, test, moving, n, G, eps2, box):
     dim = pos.shape[0]
     top = 0.0
@@ -471,7 +471,7 @@ def _gravity_rate(pos, mass, active, test, moving, n, G, eps2, box):
     return top
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def _point_mass_rate(pos, moving, n, params, f0, indices, i0, i1):
     dim = pos.shape[0]
     mu = params[f0]

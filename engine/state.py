@@ -9,10 +9,13 @@ structs (fields read without reference counting in the ``_nrt=False`` kernels):
     all x, then all y), the per-particle arrays of shape ``(capacity,)``, the ``n`` slots in
     use, and the side of the periodic space (``0.0`` for open space; see ``engine.space``).
     ``active``, ``test`` and ``pinned`` are booleans.
-``Model(kinds, params, param_offsets, indices, index_offsets)``
+``Model(kinds, params, param_offsets, indices, index_offsets, accumulators, potentials)``
     the packed force terms: term ``s`` has kind ``kinds[s]`` and parameters
-    ``params[param_offsets[s]:param_offsets[s+1]]`` (float64) and ``indices[index_offsets[s]:index_offsets[s+1]]`` (int64); the names of
-    the float parameters are given by each term's ``layout`` (``engine.forces.base``).
+    ``params[param_offsets[s]:param_offsets[s+1]]`` (float64) and
+    ``indices[index_offsets[s]:index_offsets[s+1]]`` (int64); the names of the float
+    parameters are given by each term's ``layout`` (``engine.forces.base``).
+    ``accumulators[s]`` and ``potentials[s]`` are the addresses of its kernels in this process
+    (``engine.forces.calls``), through which the force table calls them.
 ``Workspace(floats, ints, threads)``
     scratch for the large-N pair kernels (``pairwise.workspace``) and whether they may start
     a parallel region of their own (False inside a batch, whose systems already fill the cores).
@@ -24,16 +27,17 @@ import math
 from collections import namedtuple
 
 import numpy as np
-from numba import njit
+from .cache import jit
 
 State = namedtuple("State", "pos vel mass charge radius active test pinned n box")
-Model = namedtuple("Model", "kinds params param_offsets indices index_offsets")
+Model = namedtuple("Model", "kinds params param_offsets indices index_offsets accumulators "
+                   "potentials")
 Workspace = namedtuple("Workspace", "floats ints threads")
 
 EMPTY_WORKSPACE = Workspace(np.empty(0), np.empty(0, dtype=np.int64), False)
 
 
-@njit(cache=True, inline="always")
+@jit(inline="always")
 def with_motion(state, pos, vel):
     """The same particles at other positions and velocities (a Runge-Kutta stage)."""
     return State(pos, vel, state.mass, state.charge, state.radius, state.active, state.test,
@@ -44,7 +48,7 @@ def with_motion(state, pos, vel):
 INVALID_FIELDS = ("", "pos", "vel", "mass", "charge", "radius")
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _bad_motion(a, i):
     for k in range(a.shape[0]):
         if not math.isfinite(a[k, i]):
@@ -52,12 +56,12 @@ def _bad_motion(a, i):
     return False
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _bad(x, minimum):
     return not (math.isfinite(x) and x >= minimum)
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def first_invalid(state):
     """Bad input written into a state's arrays, found in one compiled pass before a step:
     0 when the state is valid, else ``field * 2**32 + particle`` (field as ``INVALID_FIELDS``)

@@ -5,6 +5,7 @@ import json
 import math
 import sys
 
+from engine import compile_ahead
 from engine.atomic import check_output_path
 
 from .rules import MODES, STARS, Rules
@@ -326,6 +327,11 @@ def _add_author_commands(sub, fmt):
     _add_rules_options(c)
     _add_fault_options(c)
 
+    a = sub.add_parser("compile", **fmt,
+                       help="compile the game's kernels ahead, one process per core (a first "
+                            "match or tournament then starts at once; CI runs it)")
+    compile_ahead.add_arguments(a)
+
 
 def _describe_match(result, timing):
     """A match's result as text, every line escaped (``seats.printable``): the bots' names
@@ -594,6 +600,13 @@ def _cmd_new_bot(args):
     return 0
 
 
+def _cmd_compile(args):
+    from .compile_ahead import TASKS
+
+    compile_ahead.main(args, TASKS)
+    return 0
+
+
 def _cmd_check(args):
     from .checker import check_bot
     from .seats import printable
@@ -618,7 +631,7 @@ def _cmd_check(args):
 
 COMMANDS = {"train": _cmd_train, "bots": _cmd_bots, "match": _cmd_match, "tournament": _cmd_tournament, "league": _cmd_league,
             "replay": _cmd_replay, "play": _cmd_play, "watch": _cmd_watch, "sandbox": _cmd_sandbox,
-            "new-bot": _cmd_new_bot, "check": _cmd_check}
+            "new-bot": _cmd_new_bot, "check": _cmd_check, "compile": _cmd_compile}
 
 
 def main(argv=None):

@@ -447,15 +447,16 @@ def new_scratch(pos):
 
 @jit()
 def step_all(actions, pos, vel, mass, charge, radius, active, test, pinned, n, box, kinds,
-             params, param_offsets, indices, index_offsets, ship_gauges, ship_counters,
-             torp_life, match_state, rng, rules, drifts, kicks):
+             params, param_offsets, indices, index_offsets, accumulators, potentials,
+             ship_gauges, ship_counters, torp_life, match_state, rng, rules, drifts, kicks):
     """Advance every match by one frame (matches already over are left as they are).
 
     The batch's ``State`` and ``Model`` come in as their arrays (numba reads plain array
     arguments faster than named tuples of them at the call from Python) and are put together
     here once."""
     state = State(pos, vel, mass, charge, radius, active, test, pinned, n, box)
-    model = Model(kinds, params, param_offsets, indices, index_offsets)
+    model = Model(kinds, params, param_offsets, indices, index_offsets, accumulators,
+                  potentials)
     # the game's pair forces run the engine's scalar pair loop (no large-N workspace), as the
     # recorded replays were played
     work = Workspace(np.empty(0), np.empty(0, dtype=np.int64), False)
@@ -467,14 +468,16 @@ def step_all(actions, pos, vel, mass, charge, radius, active, test, pinned, n, b
 
 @jit()
 def step_one_and_observe(actions, pos, vel, mass, charge, radius, active, test, pinned, n, box,
-                         kinds, params, param_offsets, indices, index_offsets, ship_gauges,
+                         kinds, params, param_offsets, indices, index_offsets, accumulators,
+                         potentials, ship_gauges,
                          ship_counters, torp_life, match_state, rng, rules, drifts, kicks, m,
                          raws):
     """Match ``m``'s frame (``step_match``), then what each seat sees next written into
     ``raws[seat]`` (``write_observation``): one call per frame for a match loop that asks
     its bots one observation at a time, whose cost is mostly the calls themselves."""
     state = State(pos, vel, mass, charge, radius, active, test, pinned, n, box)
-    model = Model(kinds, params, param_offsets, indices, index_offsets)
+    model = Model(kinds, params, param_offsets, indices, index_offsets, accumulators,
+                  potentials)
     work = Workspace(np.empty(0), np.empty(0, dtype=np.int64), False)
     step_match(m, actions, state, model, work, ship_gauges, ship_counters, torp_life,
                match_state, rng, rules, drifts, kicks, new_scratch(pos))

@@ -230,7 +230,8 @@ _BOT_MIX = np.uint64(0x2545F4914F6CDD1D)
 
 @jit(parallel=True)
 def step_learning(actions, pos, vel, mass, charge, radius, active, test, pinned, n, box, kinds,
-                  params, param_offsets, indices, index_offsets, ship_gauges, ship_counters,
+                  params, param_offsets, indices, index_offsets, accumulators, potentials,
+                  ship_gauges, ship_counters,
                   torp_life, match_state, rng, rules, drifts, kicks, scales, base,
                   episodes, frame_cap, mode, play, pending, observations, final_observations,
                   rewards, terminated, truncated, seats, memory, bot_rng):
@@ -250,7 +251,8 @@ def step_learning(actions, pos, vel, mass, charge, radius, active, test, pinned,
     plays are then written into ``observations`` (M, 2, D) float32 (a compiled bot's row is
     not). Nothing is allocated per match."""
     state = State(pos, vel, mass, charge, radius, active, test, pinned, n, box)
-    model = Model(kinds, params, param_offsets, indices, index_offsets)
+    model = Model(kinds, params, param_offsets, indices, index_offsets, accumulators,
+                  potentials)
     work = Workspace(np.empty(0), np.empty(0, dtype=np.int64), False)
     matches = pos.shape[0]
     chunks = min(matches, CHUNKS)

@@ -1,11 +1,13 @@
 """``python -m validation report --out DIR [--quick]`` | ``python -m validation bench ...`` |
-``python -m validation advise --problem NAME --error E [--t-end T]``"""
+``python -m validation advise --problem NAME --error E [--t-end T]`` |
+``python -m validation compile-times -- COMMAND ...``"""
 import argparse
 import importlib
 import sys
 
 #: the modules each command needs beyond the core install, and the extra that has them
-NEEDS = {"report": ("rebound", "matplotlib"), "bench": ("rebound",), "advise": ()}
+NEEDS = {"report": ("rebound", "matplotlib"), "bench": ("rebound",), "advise": (),
+         "compile-times": ()}
 EXTRA = "validation"
 #: the bench sections that time REBOUND side by side (the others run without it)
 BENCH_REBOUND_SECTIONS = frozenset({"direct", "small", "planets"})
@@ -48,14 +50,16 @@ def main(argv=None):
     parser = argparse.ArgumentParser(
         prog="python -m validation",
         description="Validation of the engine against REBOUND and closed forms, and benchmarks.")
-    sub = parser.add_subparsers(dest="command", metavar="{report,bench,advise}")
+    sub = parser.add_subparsers(dest="command", metavar="{report,bench,advise,compile-times}")
     sub.add_parser("report", add_help=False,
                    help="orbits, energy drift, work-precision and hard cases: DIR/report.md")
     sub.add_parser("bench", add_help=False, help="benchmarks")
     sub.add_parser("advise", add_help=False,
                    help="the cheapest integrator and step for a validation problem "
                         "(engine.advise)")
-    if not argv or argv[0] not in ("report", "bench", "advise"):
+    sub.add_parser("compile-times", add_help=False,
+                   help="what a command compiles from an empty cache, function by function")
+    if not argv or argv[0] not in NEEDS:
         parser.parse_args(argv)  # prints usage / help, or the error for an unknown command
         parser.print_help()
         return 2
@@ -70,6 +74,9 @@ def main(argv=None):
     if command == "advise":
         from . import advise
         return advise.main(rest)
+    if command == "compile-times":
+        from . import compile_times
+        return compile_times.main(rest)
     from . import bench  # written separately; imported only when asked for
     return bench.main(rest)
 

@@ -1,10 +1,10 @@
 """Small numba helpers the force kernels share."""
-from numba import njit
+from ..cache import jit
 
 from ..space import wrap_scalar as nearest_image
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def add_force(acc, i, dim, f0, f1, f2, m):
     """acc_i += f / m_i, skipping an exact zero force so a massless particle with no force
     stays finite (a massless particle *with* a force becomes infinite and the step fails)."""
@@ -16,7 +16,7 @@ def add_force(acc, i, dim, f0, f1, f2, m):
         acc[2, i] += f2 / m
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def delta(pos, i, j, dim):
     """The separation p_j - p_i as three floats (z = 0 in 2-D)."""
     dx = pos[0, j] - pos[0, i]
@@ -25,14 +25,14 @@ def delta(pos, i, j, dim):
     return dx, dy, dz
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def delta_periodic(pos, i, j, dim, box):
     """p_j - p_i, by the nearest periodic image when ``box`` > 0."""
     dx, dy, dz = delta(pos, i, j, dim)
     return nearest_image(dx, box), nearest_image(dy, box), nearest_image(dz, box)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def pair_box(params, f0, state):
     """The periodic side a pair term (gravity, Coulomb) uses: its own deprecated ``box`` at
     ``params[f0 + 2]`` when set, else the space's."""

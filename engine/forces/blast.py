@@ -10,7 +10,7 @@ the centre's edge, so a short, strong blast is an explosion and a long weak one 
 import math
 
 import numpy as np
-from numba import njit
+from ..cache import jit
 
 from ._kernels import add_force, nearest_image
 from .base import Force, EMPTY_INTS
@@ -19,7 +19,7 @@ from .._validate import finite_float, positive_float, vector
 KIND = 9
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@jit(error_model="numpy", _nrt=False)
 def accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work):
     pos = state.pos
     mass = state.mass
@@ -45,7 +45,7 @@ def accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work):
         add_force(acc, i, dim, s * dx, s * dy, s * dz, mass[i])
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@jit(error_model="numpy", _nrt=False)
 def potential(t, state, params, f0, f1, indices, i0, i1):
     return 0.0
 

@@ -12,7 +12,7 @@ Point particles (radius 0) displace nothing and feel no buoyancy.
 """
 import math
 
-from numba import njit
+from ..cache import jit
 
 from ._kernels import add_force
 from .base import Force, floats, ints
@@ -21,13 +21,13 @@ from .._validate import finite_float, nonnegative_float, positive_float
 KIND = 8
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _depth(level, height, radius):
     d = level - (height - radius)
     return min(max(d, 0.0), 2.0 * radius)
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def submerged(d, radius, dim):
     """Submerged volume (3-D) or area (2-D) of a ball of ``radius`` dipped to depth ``d``."""
     if dim == 3:
@@ -36,7 +36,7 @@ def submerged(d, radius, dim):
     return radius * radius * math.acos(u / radius) - u * math.sqrt(max(radius * radius - u * u, 0.0))
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def _submerged_integral(d, radius, dim):
     """integral_0^d submerged(s) ds, in closed form."""
     if dim == 3:
@@ -48,7 +48,7 @@ def _submerged_integral(d, radius, dim):
              + w ** 1.5 / 3.0)
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@jit(error_model="numpy", _nrt=False)
 def accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work):
     pos = state.pos
     mass = state.mass
@@ -71,7 +71,7 @@ def accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work):
         add_force(acc, i, dim, f0, f1, f2, mass[i])
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@jit(error_model="numpy", _nrt=False)
 def potential(t, state, params, f0, f1, indices, i0, i1):
     pos = state.pos
     radius = state.radius

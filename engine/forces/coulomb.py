@@ -10,7 +10,7 @@ about gravity only).
 import math
 import warnings
 
-from numba import njit
+from ..cache import jit
 
 from . import pairwise
 from ._kernels import add_force, delta_periodic, pair_box
@@ -20,7 +20,7 @@ from .._validate import nonnegative_float, finite_float, optional, positive_floa
 KIND = 3
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@jit(error_model="numpy", _nrt=False)
 def accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work):
     pos = state.pos
     mass = state.mass
@@ -48,7 +48,7 @@ def accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work):
             add_force(acc, j, dim, s * dx, s * dy, s * dz, mass[j])
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@jit(error_model="numpy", _nrt=False)
 def potential(t, state, params, f0, f1, indices, i0, i1):
     pos = state.pos
     charge = state.charge

@@ -5,7 +5,7 @@ energy": always include attrition). Not conservative: it has no potential.
 """
 import math
 
-from numba import njit
+from ..cache import jit
 
 from ._kernels import add_force
 from .base import Force, floats, EMPTY_INTS
@@ -14,7 +14,7 @@ from .._validate import nonnegative_float
 KIND = 5
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@jit(error_model="numpy", _nrt=False)
 def accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work):
     pos = state.pos
     vel = state.vel
@@ -34,7 +34,7 @@ def accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work):
         add_force(acc, i, dim, s * vx, s * vy, s * vz, mass[i])
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@jit(error_model="numpy", _nrt=False)
 def potential(t, state, params, f0, f1, indices, i0, i1):
     return 0.0
 

@@ -14,7 +14,7 @@ particles costs nothing: O(N_massive x N) for test particles around a few bodies
 import math
 import warnings
 
-from numba import njit
+from ..cache import jit
 
 from . import pairwise
 from ._kernels import delta_periodic, nearest_image, pair_box
@@ -24,7 +24,7 @@ from .._validate import nonnegative_float, one_of, optional, positive_float
 KIND = 0
 
 
-@njit(cache=True, error_model="numpy", _nrt=False, inline="always")
+@jit(error_model="numpy", _nrt=False, inline="always")
 def _all_massive_and_active(active, test, n):
     for i in range(n):
         if test[i] or not active[i]:
@@ -32,7 +32,7 @@ def _all_massive_and_active(active, test, n):
     return True
 
 
-@njit(cache=True, error_model="numpy", _nrt=False, inline="always")
+@jit(error_model="numpy", _nrt=False, inline="always")
 def _open_space_3d(pos, mass, n, G, eps2, acc):
     """The common case without flags or periodic images: no branch in the pair loop (a small
     system's step is then as fast as a hand-written loop)."""
@@ -63,7 +63,7 @@ def _open_space_3d(pos, mass, n, G, eps2, acc):
         acc[2, i] += azi
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@jit(error_model="numpy", _nrt=False)
 def accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work):
     pos = state.pos
     mass = state.mass
@@ -117,7 +117,7 @@ def accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work):
             acc[2, i] += azi
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@jit(error_model="numpy", _nrt=False)
 def potential(t, state, params, f0, f1, indices, i0, i1):
     pos = state.pos
     mass = state.mass

@@ -24,7 +24,9 @@ their extent by a power of two, so that no unit system overflows r^3.
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
+
+from ..cache import jit
 
 from ..space import image
 from ..state import Workspace
@@ -62,13 +64,13 @@ def workspace(n, threads=True):
     return Workspace(np.empty(8 * n), np.empty(n, dtype=np.int64), bool(threads))
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def usable(n, work):
     """Does this call take the vectorised path: enough particles, and a workspace for them?"""
     return n >= PARALLEL_MIN and work.floats.shape[0] >= 8 * n and work.ints.shape[0] >= n
 
 
-@njit(cache=True, fastmath=SIMD_MATH, error_model="numpy", inline="always")
+@jit(fastmath=SIMD_MATH, error_model="numpy", inline="always")
 def _target(c, x, y, z, alpha, beta, sources, eps2, box, zero, half, ax, ay, az):
     """a_c = alpha_c sum_{j < sources, j != c} beta_j d / r^3, in one branch-free pass over
     the sources that reads only, so it vectorises.
@@ -107,7 +109,7 @@ def _signature(real):
     return f"void({', '.join([arr] * 5)}, int64, int64, {real}, {real}, {', '.join([arr] * 3)})"
 
 
-@njit(_signature("float64"), parallel=True, cache=True, fastmath=SIMD_MATH, error_model="numpy")
+@jit(signature=_signature("float64"), parallel=True, fastmath=SIMD_MATH, error_model="numpy")
 def field(x, y, z, alpha, beta, targets, sources, eps2, box, ax, ay, az):
     """The field on particles [0, targets) from particles [0, sources), targets spread over
     all cores. Particles from ``sources`` on only feel the field (test particles)."""
@@ -115,7 +117,7 @@ def field(x, y, z, alpha, beta, targets, sources, eps2, box, ax, ay, az):
         _target(c, x, y, z, alpha, beta, sources, eps2, box, 0.0, 0.5, ax, ay, az)
 
 
-@njit(_signature("float64"), cache=True, fastmath=SIMD_MATH, error_model="numpy")
+@jit(signature=_signature("float64"), fastmath=SIMD_MATH, error_model="numpy")
 def field_serial(x, y, z, alpha, beta, targets, sources, eps2, box, ax, ay, az):
     """``field`` on one core: for mid-sized systems, where waking the other threads for each
     evaluation costs more than it saves (and a busy machine can stall a parallel region)."""
@@ -123,7 +125,7 @@ def field_serial(x, y, z, alpha, beta, targets, sources, eps2, box, ax, ay, az):
         _target(c, x, y, z, alpha, beta, sources, eps2, box, 0.0, 0.5, ax, ay, az)
 
 
-@njit(_signature("float32"), parallel=True, cache=True, fastmath=SIMD_MATH32, error_model="numpy")
+@jit(signature=_signature("float32"), parallel=True, fastmath=SIMD_MATH32, error_model="numpy")
 def field32(x, y, z, alpha, beta, targets, sources, eps2, box, ax, ay, az):
     """``field`` in single precision: 16 lanes per AVX-512 instruction instead of 8."""
     for c in prange(targets):
@@ -131,7 +133,7 @@ def field32(x, y, z, alpha, beta, targets, sources, eps2, box, ax, ay, az):
                 ax, ay, az)
 
 
-@njit(_signature("float32"), cache=True, fastmath=SIMD_MATH32, error_model="numpy")
+@jit(signature=_signature("float32"), fastmath=SIMD_MATH32, error_model="numpy")
 def field32_serial(x, y, z, alpha, beta, targets, sources, eps2, box, ax, ay, az):
     """``field32`` on one core."""
     for c in range(targets):
@@ -139,14 +141,14 @@ def field32_serial(x, y, z, alpha, beta, targets, sources, eps2, box, ax, ay, az
                 ax, ay, az)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _blocks(work, m):
     """The eight blocks of m in ``work``: x, y, z, alpha, beta (inputs), ax, ay, az (results)."""
     return (work[0:m], work[m:2 * m], work[2 * m:3 * m], work[3 * m:4 * m], work[4 * m:5 * m],
             work[5 * m:6 * m], work[6 * m:7 * m], work[7 * m:8 * m])
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _field(work, m, sources, eps2, box, threads):
     """The field of the m gathered particles in float64 ``work``."""
     x, y, z, alpha, beta, ax, ay, az = _blocks(work, m)
@@ -156,7 +158,7 @@ def _field(work, m, sources, eps2, box, threads):
         field_serial(x, y, z, alpha, beta, m, sources, eps2, box, ax, ay, az)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _field32(work, m, sources, eps2, box, threads):
     """The field of the m gathered particles in float32 ``work``."""
     x, y, z, alpha, beta, ax, ay, az = _blocks(work, m)
@@ -168,7 +170,7 @@ def _field32(work, m, sources, eps2, box, threads):
         field32_serial(x, y, z, alpha, beta, m, sources, e, b, ax, ay, az)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _power_of_two_above(x):
     """The smallest power of two >= x (1.0 for x = 0): scaling by it is exact."""
     if x == 0.0 or not math.isfinite(x):
@@ -177,7 +179,7 @@ def _power_of_two_above(x):
     return math.ldexp(1.0, exponent)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _frame(pos, iwork, m):
     """Centre and length scale of the m chosen particles, for float32 coordinates: their mean
     position, and a power of two at least their largest distance from it along an axis. The
@@ -204,7 +206,7 @@ def _frame(pos, iwork, m):
     return cx, cy, cz, _power_of_two_above(extent)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _gather(pos, iwork, m, work, cx, cy, cz, length):
     """Copy the m chosen particles' coordinates, as (p - centre) / length, into work's first
     three blocks of m (converted to work's precision)."""
@@ -216,7 +218,7 @@ def _gather(pos, iwork, m, work, cx, cy, cz, length):
         work[2 * m + c] = (pos[2, i] - cz) / length if dim == 3 else 0.0
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _scatter(acc, iwork, m, work, scale):
     """acc += scale * the results in work's last three blocks (scale undoes the float32 frame;
     1.0, exactly, in float64)."""
@@ -229,7 +231,7 @@ def _scatter(acc, iwork, m, work, scale):
             acc[2, i] += scale * work[7 * m + c]
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _gravity_inputs(pos, mass, iwork, m, G, work, cx, cy, cz, length, weight):
     """Coordinates in the frame (centre, length), alpha = 1, beta = G m / weight into work."""
     _gather(pos, iwork, m, work, cx, cy, cz, length)
@@ -238,7 +240,7 @@ def _gravity_inputs(pos, mass, iwork, m, G, work, cx, cy, cz, length, weight):
         work[4 * m + c] = G * mass[iwork[c]] / weight
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def gravity(pos, mass, active, test, n, G, eps2, box, single, acc, workspace):
     """acc += gravity of the active non-test particles on every active particle (large N);
     ``single``: pair sums in float32 (the workspace's memory seen as float32)."""
@@ -280,7 +282,7 @@ def gravity(pos, mass, active, test, n, G, eps2, box, single, acc, workspace):
         _scatter(acc, iwork, m, work, 1.0)
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def coulomb(pos, mass, charge, active, n, k_e, eps2, box, acc, workspace):
     """acc += Coulomb accelerations among the active charged particles (large N)."""
     work = workspace.floats

@@ -8,7 +8,7 @@ next step on.
 """
 import math
 
-from numba import njit
+from ..cache import jit
 
 from ._kernels import nearest_image
 from .base import Force, check_particles, particle_list
@@ -19,13 +19,13 @@ import numpy as np
 KIND = 1
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _target(indices, i0, i1, k):
     """The k-th particle the attractor acts on: every particle, or only those listed in indices."""
     return k if i1 == i0 else indices[i0 + k]
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@jit(error_model="numpy", _nrt=False)
 def accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work):
     pos = state.pos
     active = state.active
@@ -52,7 +52,7 @@ def accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work):
             acc[2, i] -= s * dz
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@jit(error_model="numpy", _nrt=False)
 def potential(t, state, params, f0, f1, indices, i0, i1):
     pos = state.pos
     mass = state.mass

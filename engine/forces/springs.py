@@ -14,7 +14,7 @@ coincide has no direction and makes the step fail loudly.
 import math
 
 import numpy as np
-from numba import njit
+from ..cache import jit
 
 from ._kernels import add_force, delta, delta_periodic
 from .base import Force
@@ -23,7 +23,7 @@ from .._validate import index_array, per_item, vector, positive_float, nonnegati
 KIND = 4
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@jit(error_model="numpy", _nrt=False)
 def accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work):
     pos = state.pos
     vel = state.vel
@@ -51,7 +51,7 @@ def accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work):
         add_force(acc, b, dim, -scale * dx, -scale * dy, -scale * dz, mass[b])
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@jit(error_model="numpy", _nrt=False)
 def potential(t, state, params, f0, f1, indices, i0, i1):
     pos = state.pos
     active = state.active

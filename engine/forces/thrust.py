@@ -4,7 +4,7 @@ a_i = f_i / m_i. It has no physical justification and no potential (lecture, "co
 forces"). ``thrust.set(i, f)`` acts from the very next step: the simulation re-reads it.
 """
 import numpy as np
-from numba import njit
+from ..cache import jit
 
 from ._kernels import add_force
 from .base import Force, check_particles, particle_list
@@ -13,7 +13,7 @@ from .._validate import vector
 KIND = 6
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@jit(error_model="numpy", _nrt=False)
 def accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work):
     pos = state.pos
     mass = state.mass
@@ -30,7 +30,7 @@ def accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work):
         add_force(acc, i, dim, params[f0 + r * dim], params[f0 + r * dim + 1], f2, mass[i])
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@jit(error_model="numpy", _nrt=False)
 def potential(t, state, params, f0, f1, indices, i0, i1):
     return 0.0
 

@@ -2,7 +2,7 @@
 
 f = m g,  a = g,  U = -sum_i m_i g . p_i      (lecture, "gravitational forces near a planet")
 """
-from numba import njit
+from ..cache import jit
 
 from .base import Force, EMPTY_INTS
 from .._validate import vector
@@ -10,7 +10,7 @@ from .._validate import vector
 KIND = 2
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@jit(error_model="numpy", _nrt=False)
 def accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work):
     pos = state.pos
     active = state.active
@@ -23,7 +23,7 @@ def accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work):
             acc[k, i] += params[f0 + k]
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@jit(error_model="numpy", _nrt=False)
 def potential(t, state, params, f0, f1, indices, i0, i1):
     pos = state.pos
     mass = state.mass

@@ -10,7 +10,7 @@ wind, the larger the push, always along the wind. Not conservative.
 import math
 
 import numpy as np
-from numba import njit
+from ..cache import jit
 
 from ._kernels import add_force, delta_periodic
 from .base import Force
@@ -19,7 +19,7 @@ from .._validate import index_array, vector
 KIND = 7
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@jit(error_model="numpy", _nrt=False)
 def accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work):
     pos = state.pos
     mass = state.mass
@@ -46,7 +46,7 @@ def accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work):
             add_force(acc, v, 3, f * wx, f * wy, f * wz, mass[v])
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@jit(error_model="numpy", _nrt=False)
 def potential(t, state, params, f0, f1, indices, i0, i1):
     return 0.0
 

@@ -6,6 +6,7 @@ named tuples of ``engine.state``).
 """
 import numpy as np
 
+from ..forces import gravity
 from ..forces.pairwise import workspace
 from . import direct as _direct
 from . import dormand_prince, euler, ias15, janus, runge_kutta, splitting, wisdom_holman
@@ -93,7 +94,12 @@ def advance(name, t, h, steps, state, model, vdep, t_end=np.nan, tol=1e-9, work=
         work = workspace(state.n)
     run = _direct.call if direct else _dispatch_call
     if name in _COEFFICIENTS:
-        return splitting.advance(t, h, steps, state, model, work, vdep, t_end, *_COEFFICIENTS[name])
+        # only a scene of one gravity term can take the fused executor: any other compiles
+        # and runs the general one alone
+        kinds = model.kinds
+        fusable = kinds.shape[0] == 1 and kinds[0] == gravity.KIND
+        executor = splitting.advance if fusable else splitting.advance_general
+        return executor(t, h, steps, state, model, work, vdep, t_end, *_COEFFICIENTS[name])
     if name == "euler":
         return euler.advance(t, h, steps, state, model, work, vdep, t_end)
     if name == "ias15":

@@ -12,7 +12,7 @@ used by adaptive methods (they shorten their last step to land on it; NaN means 
 import math
 
 import numpy as np
-from numba import njit
+from ..cache import jit
 
 from ..space import period_shift, wrap_scalar
 
@@ -22,7 +22,7 @@ STEP_COLLAPSED = -2
 TIME_OVERFLOW = -3
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def drift(pos, vel, mask, n, h, box):
     """p <- p + h v, v masked to 0 for inactive and pinned particles (so they stay exactly
     put); the moving ones are then wrapped onto the periodic space of side ``box`` (none when
@@ -40,7 +40,7 @@ def drift(pos, vel, mask, n, h, box):
             pos[k, i] += (h * mask[i]) * vel[k, i]
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def wrap_positions(pos, mask, n, box):
     """Every moving particle's position onto the periodic space (a Runge-Kutta step's end)."""
     if box > 0.0:
@@ -50,7 +50,7 @@ def wrap_positions(pos, mask, n, box):
                     pos[k, i] = wrap_scalar(pos[k, i], box)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def kick(vel, acc, mask, n, h):
     """v <- v + h a, masked to 0 for pinned (and inactive) particles, so a pinned particle's
     velocity stays zero whatever acts on it (h * 1.0 is h: the others' kicks are exact)."""
@@ -59,7 +59,7 @@ def kick(vel, acc, mask, n, h):
             vel[k, i] += (h * mask[i]) * acc[k, i]
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def hold_pinned(acc, pinned, n):
     """Zero the accelerations of pinned particles (Runge-Kutta stages: a pinned particle's
     stage velocity must stay zero, so that its stage positions do not move)."""
@@ -69,7 +69,17 @@ def hold_pinned(acc, pinned, n):
                 acc[k, i] = 0.0
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
+def copy_columns(src, dst, n):
+    """dst[:, :n] = src[:, :n], as a loop: numba compiles a slice assignment with the error
+    message of a shape mismatch, whose string formatting cost seconds of compiling in every
+    integrator that had one."""
+    for k in range(src.shape[0]):
+        for i in range(n):
+            dst[k, i] = src[k, i]
+
+
+@jit(error_model="numpy", inline="always")
 def copy_state(src_pos, src_vel, dst_pos, dst_vel, n):
     for k in range(src_pos.shape[0]):
         for i in range(n):
@@ -77,7 +87,7 @@ def copy_state(src_pos, src_vel, dst_pos, dst_vel, n):
             dst_vel[k, i] = src_vel[k, i]
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def active_mask(active, pinned, n):
     """1.0 for the particles that move (active and not pinned), else 0.0."""
     mask = np.empty(n)
@@ -85,14 +95,14 @@ def active_mask(active, pinned, n):
     return mask
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def fill_active_mask(mask, active, pinned, n):
     """``active_mask`` into a caller's array."""
     for i in range(n):
         mask[i] = 1.0 if active[i] and not pinned[i] else 0.0
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def all_finite(pos, vel, n):
     """True if every position and velocity is finite: x * 0 is 0 for finite x and NaN for
     inf or NaN, and a sum of zeros never overflows, so one cheap vectorisable pass decides."""
@@ -103,7 +113,7 @@ def all_finite(pos, vel, n):
     return s == 0.0
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def first_nonfinite(pos, vel, active, n):
     """Index of the first active particle with a non-finite position or velocity, else -1."""
     for i in range(n):
@@ -115,7 +125,7 @@ def first_nonfinite(pos, vel, active, n):
     return -1
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def first_nonfinite_array(a, active, n):
     for i in range(n):
         if not active[i]:

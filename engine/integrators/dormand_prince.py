@@ -14,12 +14,12 @@ h * min(5, max(0.2, 0.9 err^(-1/5))) for the next (no growth right after a rejec
 import math
 
 import numpy as np
-from numba import njit
+from ..cache import jit
 
 from ..forces.dispatch import accelerations
 from ..state import with_motion
-from .common import (OK, STEP_COLLAPSED, TIME_OVERFLOW, active_mask, first_nonfinite,
-                     first_nonfinite_array, hold_pinned, wrap_positions)
+from .common import (OK, STEP_COLLAPSED, TIME_OVERFLOW, active_mask, copy_columns, copy_state,
+                     first_nonfinite, first_nonfinite_array, hold_pinned, wrap_positions)
 
 NAME = "rk45"
 ORDER = 5
@@ -42,7 +42,7 @@ _MIN_FACTOR = 0.2
 _MAX_FACTOR = 5.0
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _stage_state(pos, vel, kx, kv, s, h, n, out_pos, out_vel):
     """y + h sum_{j<s} a_sj k_j."""
     for k in range(pos.shape[0]):
@@ -58,7 +58,7 @@ def _stage_state(pos, vel, kx, kv, s, h, n, out_pos, out_vel):
             out_vel[k, i] = v
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _error(pos, vel, new_pos, new_vel, kx, kv, h, tol, active, n):
     err = 0.0
     for k in range(pos.shape[0]):
@@ -76,14 +76,14 @@ def _error(pos, vel, new_pos, new_vel, kx, kv, h, tol, active, n):
     return err
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def advance(t, h, steps, state, model, work, vdep, t_end, tol):
     """``advance_counted`` without the count."""
     return advance_counted(t, h, steps, state, model, work, vdep, t_end, tol,
                            np.zeros(1, dtype=np.int64))
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def advance_counted(t, h, steps, state, model, work, vdep, t_end, tol, counts):
     """``steps`` accepted steps (see the module); ``counts[0]`` gains the force evaluations
     made, rejected attempts included (1 at the start, 6 per attempt)."""
@@ -99,7 +99,7 @@ def advance_counted(t, h, steps, state, model, work, vdep, t_end, tol, counts):
     sv = np.empty((dim, n))
     stage = with_motion(state, sx, sv)
     has_end = not math.isnan(t_end)
-    kx[0, :, :] = vel[:, :n]
+    copy_columns(vel, kx[0], n)
     accelerations(t, state, model, kv[0], work)
     counts[0] += 1
     hold_pinned(kv[0], state.pinned, n)
@@ -120,7 +120,7 @@ def advance_counted(t, h, steps, state, model, work, vdep, t_end, tol, counts):
         counts[0] += 6
         for s in range(1, 7):
             _stage_state(pos, vel, kx, kv, s, h_try, n, sx, sv)
-            kx[s, :, :] = sv
+            copy_columns(sv, kx[s], n)
             accelerations(t + _C[s] * h_try, stage, model, kv[s], work)
             hold_pinned(kv[s], state.pinned, n)
         # stage 7 state is the fifth-order solution (sx, sv)
@@ -144,8 +144,7 @@ def advance_counted(t, h, steps, state, model, work, vdep, t_end, tol, counts):
                     vel[k, i] = sv[k, i]
         wrap_positions(pos, mask, n, state.box)
         t = t_end if last else t + h_try
-        kx[0, :, :] = kx[6]
-        kv[0, :, :] = kv[6]
+        copy_state(kx[6], kv[6], kx[0], kv[0], n)
         factor = _MAX_FACTOR if err == 0.0 else min(_MAX_FACTOR, max(_MIN_FACTOR, _SAFETY * err ** -0.2))
         if rejected:
             factor = min(factor, 1.0)

@@ -5,7 +5,7 @@
 First order, not symplectic: the energy of a bound orbit grows step after step.
 """
 import numpy as np
-from numba import njit
+from ..cache import jit
 
 from ..forces.dispatch import accelerations
 from ..space import wrap_scalar
@@ -16,7 +16,7 @@ ORDER = 1
 FORCE_EVALUATIONS = 1
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def advance(t, h, steps, state, model, work, vdep, t_end):
     pos = state.pos
     vel = state.vel

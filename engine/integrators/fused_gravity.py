@@ -24,7 +24,7 @@ executor does.
 import math
 
 import numpy as np
-from numba import njit
+from ..cache import jit
 
 from ..forces import gravity, pairwise
 from .common import OK
@@ -33,7 +33,7 @@ from .common import OK
 BLOCK = 64
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def applies(state, model):
     """Is this call the fused case: one open-space gravity term, few bodies, none of them test
     particles or pinned?"""
@@ -49,7 +49,7 @@ def applies(state, model):
     return True
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _gravity(P, gm, m, eps2, A):
     """A = accelerations of the m bodies at positions P (rows), G m_j in gm: the pair loop of
     ``gravity._open_space_3d`` on interleaved rows.
@@ -93,7 +93,7 @@ def _gravity(P, gm, m, eps2, A):
             A[i, 2] += azi
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _add_scaled(X, Y, m, h):
     """X += h Y over the m rows (a drift with Y = velocities, a kick with Y = accelerations)."""
     for i in range(m):
@@ -102,7 +102,7 @@ def _add_scaled(X, Y, m, h):
         X[i, 2] += h * Y[i, 2]
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _steps(P, V, A, gm, m, eps2, h, count, drifts, kicks, fresh):
     """``count`` steps of the scheme; returns whether A holds the forces of the final P."""
     for _ in range(count):
@@ -118,7 +118,7 @@ def _steps(P, V, A, gm, m, eps2, h, count, drifts, kicks, fresh):
     return fresh
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _first_nonfinite_row(P, V, m):
     for i in range(m):
         for k in range(3):
@@ -127,7 +127,7 @@ def _first_nonfinite_row(P, V, m):
     return -1
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _finite(P, V, m):
     s = 0.0
     for i in range(m):
@@ -136,7 +136,7 @@ def _finite(P, V, m):
     return s == 0.0
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _copy(src_a, src_b, src_c, dst_a, dst_b, dst_c, m):
     for i in range(m):
         for k in range(3):
@@ -145,7 +145,7 @@ def _copy(src_a, src_b, src_c, dst_a, dst_b, dst_c, m):
             dst_c[i, k] = src_c[i, k]
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def advance(t, h, steps, pos, vel, mass, active, n, G, eps2, drifts, kicks):
     """``splitting.advance`` for the case ``applies`` accepts; same returns."""
     dim = pos.shape[0]

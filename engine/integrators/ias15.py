@@ -88,7 +88,7 @@ import math
 from fractions import Fraction
 
 import numpy as np
-from numba import njit
+from ..cache import jit
 
 from ..forces.dispatch import accelerations
 from . import fused_gravity
@@ -214,7 +214,7 @@ def statistics(memory):
             "capped": int(memory[MEMORY_CAPPED])}
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _views(memory, dim, n):
     """The blocks of ``memory``: b, e, b_done, e_done as ``(7, dim n)`` (each row the components
     in (k, i) order, so the loops over components are plain vector loops), the compensation
@@ -240,7 +240,7 @@ def _views(memory, dim, n):
 
 
 # -- small pieces ---------------------------------------------------------------------------------
-@njit(cache=True, error_model="numpy", fastmath=False)
+@jit(error_model="numpy", fastmath=False)
 def root7(a):
     """a^(1/7) for a > 0 by Newton's method from above (fixed iteration count, so the result
     depends only on IEEE arithmetic, not on the platform's pow); NaN for a <= 0 or non-finite."""
@@ -259,7 +259,7 @@ def root7(a):
     return math.ldexp(x, q)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _kahan(total, comp, term):
     """Compensated sum: returns (total', comp') with total' - comp' = total - comp + term."""
     y = term - comp
@@ -267,7 +267,7 @@ def _kahan(total, comp, term):
     return s, (s - total) - y
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _first_bad(a, mask, n):
     for i in range(n):
         if mask[i] != 0.0:
@@ -277,7 +277,7 @@ def _first_bad(a, mask, n):
     return -1
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _predict(b_done, e_done, b, e, ratio, w):
     """Everhart's predictor: the b, e for a step ``ratio`` times the last accepted one
     (``w``: scratch of one row)."""
@@ -301,7 +301,7 @@ def _predict(b_done, e_done, b, e, ratio, w):
             b[j, c] = ej + (b_done[j, c] - e_done[j, c])
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _rescale(b, ratio):
     """The same acceleration polynomial over a step ``ratio`` times as long (same start)."""
     if not (abs(ratio) <= _NO_PREDICTION):
@@ -314,7 +314,7 @@ def _rescale(b, ratio):
             b[j, c] *= f
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _forces(t, state, model, acc, work, fused):
     """The accelerations of every declared term; for ``fused`` scenes (one open-space gravity
     term on a few bodies, ``fused_gravity.applies``) the pair loop inline, each pair once
@@ -373,7 +373,7 @@ def _forces(t, state, model, acc, work, fused):
             acc[2, i] = az
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _horner(b, weights, s, w, m):
     """w = sum_j weights[j] b_j s^j for every component (Horner in s, one vector loop per
     coefficient): the position (``_XINV``) or velocity (``_VINV``) polynomial at a node."""
@@ -385,7 +385,7 @@ def _horner(b, weights, s, w, m):
             w[c] = w[c] * s + b[j, c] * f
 
 
-@njit(cache=True, error_model="numpy", fastmath={"reassoc"})
+@jit(error_model="numpy", fastmath={"reassoc"})
 def _moving_finite(acc, mask, m):
     """True if the acceleration of every moving component is finite: x * 0 is 0 for finite x
     and NaN for inf or NaN, and a sum of zeros never overflows. Compiled on its own with
@@ -398,7 +398,7 @@ def _moving_finite(acc, mask, m):
     return s == 0.0
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _positions_at(b, s, sdt, x0, v0, a0, csx, sx, m):
     """The positions at node ``s`` (``sdt`` = s dt) from the current b: ``_horner`` with
     ``_XINV`` and the position update in one pass over the components, the polynomial
@@ -418,7 +418,7 @@ def _positions_at(b, s, sdt, x0, v0, a0, csx, sx, m):
         sx[c] = x0[c] + (sdt * (v0[c] + sdt * (p * s + 0.5 * a0[c])) - csx[c])
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _iterate(t, dt, state, model, work, vdep, mask, a0, v0, x0, u0, b, csx, csv, g, csb, acc,
              sx, sv, w, change, fused):
     """The predictor-corrector on one step attempt. Returns (status, iterations, evaluations):
@@ -531,7 +531,7 @@ def _iterate(t, dt, state, model, work, vdep, mask, a0, v0, x0, u0, b, csx, csv,
     return -1, iterations, evaluations
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _park(mask, n, a0, v0, vel, b, e, b_done, e_done, csx, csv):
     """Zero what moves a particle that must not move (pinned or inactive), so the loops can
     run over every component without a branch; v0 is the velocity of the moving ones
@@ -552,7 +552,7 @@ def _park(mask, n, a0, v0, vel, b, e, b_done, e_done, csx, csv):
                     e_done[j, c] = 0.0
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _timescale2(a0, b, mask, n):
     """min over moving particles of tau_i^2 / dt^2 (Pham, Rein & Spiegel 2024), or inf
     (flat arrays, ``mask`` per component)."""
@@ -593,20 +593,20 @@ def _timescale2(a0, b, mask, n):
     return best
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _collapsed(h, t):
     """A step too short for the time to advance by it reliably (or no longer a normal float)."""
     return not (abs(h) > 8.0 * _EPS * abs(t) and abs(h) >= _MIN_NORMAL * 2.0 ** 52)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _copy(source, target):
     for j in range(source.shape[0]):
         for c in range(source.shape[1]):
             target[j, c] = source[j, c]
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _changed(pos, vel, x_end, v_end, n):
     for k in range(pos.shape[0]):
         for i in range(n):
@@ -615,7 +615,7 @@ def _changed(pos, vel, x_end, v_end, n):
     return False
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _store(memory, valid, dt_last, dt_pred, e_valid, t, tc, evaluations, rejected, capped,
           iterations, pos, vel, x_end, v_end, n):
     memory[MEMORY_VALID] = 1.0 if valid else 0.0
@@ -635,7 +635,7 @@ def _store(memory, valid, dt_last, dt_pred, e_valid, t, tc, evaluations, rejecte
 
 
 # -- the kernel -----------------------------------------------------------------------------------
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def advance(t, h, steps, state, model, work, vdep, t_end, tol, memory):
     """Up to ``steps`` accepted IAS15 steps from time ``t`` with first step ``h``.
 
@@ -663,7 +663,7 @@ def advance(t, h, steps, state, model, work, vdep, t_end, tol, memory):
                     flat[9], flat[10], flat[11], flat[12], g, csb)
 
 
-@njit(cache=True, error_model="numpy", _nrt=False, fastmath={"contract"})
+@jit(error_model="numpy", _nrt=False, fastmath={"contract"})
 def _advance(t, h, steps, state, model, work, vdep, t_end, tol, memory, mask, a0, acc, sx, sv,
              nx, nv, ncx, ncv, v0, x0, u0, w, change, g, csb):
     """``advance``'s work, in the scratch it made."""

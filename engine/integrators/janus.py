@@ -85,8 +85,9 @@ long before it stops being finite.
 import math
 
 import numpy as np
-from numba import njit
+from ..cache import jit
 
+from ..forces import gravity
 from ..forces.dispatch import accelerations_inline
 from . import fused_gravity
 from .common import OK, fill_active_mask
@@ -211,7 +212,7 @@ def on_lattice(pos, vel, n, kx, kv, active=None, pinned=None):
 
 # -- the compiled stepper ------------------------------------------------------------------------
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _round(y, truncate):
     """The odd rounding R: to nearest, ties to even, or towards zero."""
     if truncate:
@@ -219,7 +220,7 @@ def _round(y, truncate):
     return np.rint(y)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _first_bad(acc, mask, n):
     """The first moving particle with a non-finite acceleration, else -1."""
     for i in range(n):
@@ -230,13 +231,13 @@ def _first_bad(acc, mask, n):
     return -1
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _wrap(q, L):
     """q onto [-L/2, L/2) in lattice units: q - L floor((2q + L) / 2L), in integers."""
     return q - L * ((2 * q + L) // (2 * L))
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _drift(xi, vi, pos, mask, n, s, ratio, sx, L, truncate):
     """x_int += R((s v_int) 2**(kx - kv)) for the moving particles, floats written back (a
     parked particle's v_int is 0 and its float position is left as it is). No branch in the
@@ -265,7 +266,7 @@ def _drift(xi, vi, pos, mask, n, s, ratio, sx, L, truncate):
     return LATTICE_OVERFLOW
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _kick(vi, vel, acc, mask, n, s, iv, sv, truncate):
     """v_int += R((s a) 2**kv) for the moving particles, floats written back; the returns of
     ``_drift``."""
@@ -286,7 +287,7 @@ def _kick(vi, vel, acc, mask, n, s, iv, sv, truncate):
     return bad if bad >= 0 else LATTICE_OVERFLOW
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _write(xi, vi, pos, vel, mask, n, sx, sv):
     for k in range(xi.shape[0]):
         for i in range(n):
@@ -295,7 +296,7 @@ def _write(xi, vi, pos, vel, mask, n, sx, sv):
                 vel[k, i] = float(vi[k, i]) * sv
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _drift_flat(X, V, P, count, s, ratio, sx, truncate):
     """``_drift`` on the flat interleaved coordinates of the fused path (every one moves),
     without a branch in the loop: a value that would leave the lattice is replaced by 0 and
@@ -318,7 +319,7 @@ def _drift_flat(X, V, P, count, s, ratio, sx, truncate):
     return LATTICE_OVERFLOW
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _kick_flat(V, A, count, s, iv, truncate):
     """``_kick`` on the flat interleaved coordinates (the float velocities are written at
     the end of the call); same returns as ``_drift_flat``."""
@@ -338,7 +339,7 @@ def _kick_flat(V, A, count, s, iv, truncate):
     return LATTICE_OVERFLOW
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@jit(error_model="numpy", _nrt=False)
 def _steps_general(t, h, steps, state, model, work, xi, vi, save_x, save_v, acc, mask, gamma,
                    drifts, cum, ratio, sx, iv, sv, L, truncate):
     """The steps through the force table, on the (dim, n) integer copies xi, vi, in the
@@ -373,7 +374,7 @@ def _steps_general(t, h, steps, state, model, work, xi, vi, save_x, save_v, acc,
     return t, h, steps, OK
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@jit(error_model="numpy", _nrt=False)
 def _fused_loop(h, steps, X, V, save_X, save_V, P, A, P_flat, A_flat, gm, m, eps2, gamma,
                 drifts, ratio, sx, iv, truncate):
     """The hot loop of ``_steps_fused`` (without reference counting); returns (done, status)
@@ -403,7 +404,7 @@ def _fused_loop(h, steps, X, V, save_X, save_V, P, A, P_flat, A_flat, gm, m, eps
     return steps, OK
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def _steps_fused(t, h, steps, state, model, xi, vi, gamma, drifts, ratio, sx, iv, sv,
                  truncate):
     """The steps for the scenes ``fused_gravity.applies`` accepts (one open-space gravity
@@ -450,33 +451,38 @@ def _steps_fused(t, h, steps, state, model, xi, vi, gamma, drifts, ratio, sx, iv
     return (t if done == 0 else t + done * h), h, done, status
 
 
-@njit(cache=True, error_model="numpy")
-def run_lattice(t, h, steps, state, model, work, order, kx, kv, truncate, fuse):
-    """Validate, put the state on the lattice, and step by the fused path when ``fuse`` and
-    the scene allows it, else by the general one."""
-    row = -1
-    for r in range(len(ORDERS)):
-        if ORDERS[r] == order:
-            row = r
-    if row < 0:
-        return t, h, 0, BAD_ORDER
-    if abs(kx) > MAX_EXPONENT or abs(kv) > MAX_EXPONENT or abs(kx - kv) > MAX_EXPONENT:
-        return t, h, 0, BAD_LATTICE
+@jit(error_model="numpy", inline="always")
+def _prepare(state, order, kx, kv, truncate):
+    """Check the order and the lattice and put the state on it (exact for a state already on
+    it; nothing written when a check fails). Returns ``(status, xi, vi, mask, gamma, drifts,
+    cum, ratio, sx, iv, sv, L)``: status OK, or the reason not to step (the rest then unused)."""
     pos = state.pos
     vel = state.vel
     n = state.n
     dim = pos.shape[0]
+    row = -1
+    for r in range(len(ORDERS)):
+        if ORDERS[r] == order:
+            row = r
+    status = OK
+    if row < 0:
+        status = BAD_ORDER
+        row = 0
+    elif abs(kx) > MAX_EXPONENT or abs(kv) > MAX_EXPONENT or abs(kx - kv) > MAX_EXPONENT:
+        status = BAD_LATTICE
+        kx = kv = 0
     ix = math.ldexp(1.0, kx)
     sx = math.ldexp(1.0, -kx)
     iv = math.ldexp(1.0, kv)
     sv = math.ldexp(1.0, -kv)
     ratio = math.ldexp(1.0, kx - kv)
     L = np.int64(0)
-    if state.box > 0.0:
+    if status == OK and state.box > 0.0:
         lf = state.box * ix
         if not (lf < LIMIT and lf == math.floor(lf)):
-            return t, h, 0, BAD_LATTICE
-        L = np.int64(lf)
+            status = BAD_LATTICE
+        else:
+            L = np.int64(lf)
 
     stages = _STAGES[row]
     gamma = _GAMMA[row, :stages].copy()
@@ -497,6 +503,8 @@ def run_lattice(t, h, steps, state, model, work, order, kx, kv, truncate, fuse):
     fill_active_mask(mask, state.active, state.pinned, n)
     xi = np.zeros((dim, n), dtype=np.int64)
     vi = np.zeros((dim, n), dtype=np.int64)
+    if status != OK:
+        return status, xi, vi, mask, gamma, drifts, cum, ratio, sx, iv, sv, L
     # floats -> lattice (exact for a state already on it); refuse before writing anything
     for i in range(n):
         if mask[i] == 0.0:
@@ -505,46 +513,80 @@ def run_lattice(t, h, steps, state, model, work, order, kx, kv, truncate, fuse):
             y = pos[k, i] * ix
             w = vel[k, i] * iv
             if not (math.isfinite(y) and math.isfinite(w)):
-                return t, h, 0, i
+                return i, xi, vi, mask, gamma, drifts, cum, ratio, sx, iv, sv, L
             y = _round(y, truncate)
             w = _round(w, truncate)
             if not (abs(y) < LIMIT and abs(w) < LIMIT):
-                return t, h, 0, LATTICE_OVERFLOW
+                return LATTICE_OVERFLOW, xi, vi, mask, gamma, drifts, cum, ratio, sx, iv, sv, L
             xi[k, i] = _wrap(np.int64(y), L) if L > 0 else np.int64(y)
             vi[k, i] = np.int64(w)
     _write(xi, vi, pos, vel, mask, n, sx, sv)
-    if steps <= 0:
-        return t, h, 0, OK
-    if fuse and fused_gravity.applies(state, model):
-        return _steps_fused(t, h, steps, state, model, xi, vi, gamma, drifts, ratio, sx, iv,
-                            sv, truncate)
+    return OK, xi, vi, mask, gamma, drifts, cum, ratio, sx, iv, sv, L
+
+
+@jit(error_model="numpy", inline="always")
+def _general(t, h, steps, state, model, work, xi, vi, mask, gamma, drifts, cum, ratio, sx, iv,
+             sv, L, truncate):
+    """``_steps_general`` with its scratch."""
+    dim, n = xi.shape[0], state.n
     return _steps_general(t, h, steps, state, model, work, xi, vi,
                           np.empty((dim, n), dtype=np.int64), np.empty((dim, n), dtype=np.int64),
                           np.empty((dim, n)), mask, gamma, drifts, cum, ratio, sx, iv, sv, L,
                           truncate)
 
 
-#: False, True as run-time booleans: a literal ``True`` in a call would make numba compile
-#: ``run_lattice`` once more for each combination of constants (7 to 10 s each)
-_FLAGS = np.array([False, True])
+@jit(error_model="numpy")
+def run_lattice(t, h, steps, state, model, work, order, kx, kv, truncate, fuse):
+    """Validate, put the state on the lattice, and step by the fused path when ``fuse`` and
+    the scene allows it, else by the general one."""
+    status, xi, vi, mask, gamma, drifts, cum, ratio, sx, iv, sv, L = _prepare(
+        state, order, kx, kv, truncate)
+    if status != OK or steps <= 0:
+        return t, h, 0, status
+    if fuse and fused_gravity.applies(state, model):
+        return _steps_fused(t, h, steps, state, model, xi, vi, gamma, drifts, ratio, sx, iv,
+                            sv, truncate)
+    return _general(t, h, steps, state, model, work, xi, vi, mask, gamma, drifts, cum, ratio,
+                    sx, iv, sv, L, truncate)
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
+def run_lattice_general(t, h, steps, state, model, work, order, kx, kv, truncate):
+    """``run_lattice`` by the general path alone: what a scene the fused path cannot take runs
+    (chosen in Python by ``advance``), so that it never compiles the fused path."""
+    status, xi, vi, mask, gamma, drifts, cum, ratio, sx, iv, sv, L = _prepare(
+        state, order, kx, kv, truncate)
+    if status != OK or steps <= 0:
+        return t, h, 0, status
+    return _general(t, h, steps, state, model, work, xi, vi, mask, gamma, drifts, cum, ratio,
+                    sx, iv, sv, L, truncate)
+
+
+def _fusable(model):
+    """Can the fused path take this scene (one gravity term; ``fused_gravity.applies`` then
+    decides the rest in compiled code)?"""
+    return model.kinds.shape[0] == 1 and model.kinds[0] == gravity.KIND
+
+
 def advance(t, h, steps, state, model, work, vdep, t_end, order, kx, kv):
     """``steps`` JANUS steps of order ``order`` on the lattice ``(2**-kx, 2**-kv)``, rounding to
     nearest; returns ``(t, h, done, status)`` (see the module's doc). ``t_end`` is ignored
     (fixed step); ``vdep`` changes nothing here (each kick evaluates the forces afresh, with
     the current velocities)."""
-    return run_lattice(t, h, steps, state, model, work, order, kx, kv, _FLAGS[0], _FLAGS[1])
+    if _fusable(model):
+        return run_lattice(t, h, steps, state, model, work, order, kx, kv, False, True)
+    return run_lattice_general(t, h, steps, state, model, work, order, kx, kv, False)
 
 
-@njit(cache=True, error_model="numpy")
 def advance_truncating(t, h, steps, state, model, work, vdep, t_end, order, kx, kv):
     """``advance`` with the rounding of REBOUND's JANUS (towards zero), for comparisons."""
-    return run_lattice(t, h, steps, state, model, work, order, kx, kv, _FLAGS[1], _FLAGS[1])
+    if _fusable(model):
+        return run_lattice(t, h, steps, state, model, work, order, kx, kv, True, True)
+    return run_lattice_general(t, h, steps, state, model, work, order, kx, kv, True)
 
 
 __all__ = ["NAME", "ORDERS", "SCHEMES", "FORCE_EVALUATIONS", "LATTICE_OVERFLOW", "BAD_LATTICE",
            "BAD_ORDER", "HEADROOM_BITS", "LIMIT", "MAX_EXPONENT", "advance",
            "advance_truncating", "lattice_exponents", "on_lattice", "run_lattice",
+           "run_lattice_general",
            "stage_coefficients"]

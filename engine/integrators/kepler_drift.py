@@ -31,7 +31,7 @@ there).
 import math
 
 import numpy as np
-from numba import njit
+from ..cache import jit
 
 from ..analytic import kepler_step
 
@@ -47,7 +47,7 @@ _R72, _R90, _R110, _R132, _R156, _R182, _R210 = (1 / 72, 1 / 90, 1 / 110, 1 / 13
                                                   1 / 182, 1 / 210)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def stumpff(z):
     """c0(z), c1(z), c2(z), c3(z) by the series at small |z| and quadruple-argument steps;
     below |z| = 2e-3 (a planet's step of under a thirtieth of its orbit) four terms of each
@@ -79,7 +79,7 @@ def stumpff(z):
     return c0, c1, c2, c3
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _column(jp, jv, j):
     """Column j's position and velocity as six scalars (z = vz = 0 in two dimensions), and
     r0 = |r|, v^2 and eta0 = r . v."""
@@ -94,7 +94,7 @@ def _column(jp, jv, j):
     return x, y, z, vx, vy, vz, r0, vx * vx + vy * vy + vz * vz, x * vx + y * vy + z * vz
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _third_order_start(dt, inv, eta0, v2, mu):
     """X = integral of dt / r, from the Taylor series of 1/r to third order in dt (r' = eta0 /
     r0, r'' = (v0^2 - r'^2) / r0 - mu / r0^2; ``inv`` = 1 / r0)."""
@@ -103,7 +103,7 @@ def _third_order_start(dt, inv, eta0, v2, mu):
     return dt * inv * (1.0 + dt * inv * (-0.5 * rd + dt * (2.0 * rd * rd * inv - rdd) * _R6))
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _start_of_x(dt, r0, eta0, v2, beta, mu):
     """``(X, dt)``: where Halley's iteration for X starts, and the time it solves for."""
     if beta > 0.0 and dt * dt * beta * beta * beta > _LONG_ARC * mu * mu:
@@ -121,7 +121,7 @@ def _start_of_x(dt, r0, eta0, v2, beta, mu):
     return dt * inv, dt
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def drift_column(jp, jv, j, mu, dt, r, v):
     """Column ``j`` of positions ``jp`` and velocities ``jv`` (dim, count) moved along its
     Kepler orbit about mu for time dt, in place. ``r``, ``v`` are dim-long scratch for the
@@ -202,7 +202,7 @@ SCRATCH_ROWS = 14
 R0_ROW, INV_R0_ROW = _R0, _INV
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _start(jp, jv, j, mu, dt, kw, known):
     """Column j's invariants and the start of X into ``kw``, as ``drift_column`` starts
     (``_start_of_x``; whole periods of a long elliptic arc dropped from ``kw[_DT]``);
@@ -226,7 +226,7 @@ def _start(jp, jv, j, mu, dt, kw, known):
     kw[_DT, j] = dt
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _halley_all(kw, first, count):
     """Halley's iteration for X of every pending column (``kw[_OK]`` 1), the columns in
     lockstep, as ``drift_column`` iterates: a column whose correction was at most 1e-7 of X
@@ -275,7 +275,7 @@ def _halley_all(kw, first, count):
             kw[_OK, j] = 0.0
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _apply_all(jp, jv, kw, first, count):
     """x' = f x + g v, v' = fd x + gd v for every column solved (``kw[_OK]`` 2), from the
     Lagrange coefficients f = 1 - mu G2 / r0, g = r0 G1 + eta0 G2, fd = -mu G1 / (r0 r),
@@ -301,14 +301,14 @@ def _apply_all(jp, jv, kw, first, count):
             jv[k, j] = fd * x + gd * v if ok else v
 
 
-@njit(cache=True, error_model="numpy", _nrt=False, fastmath=False)
+@jit(error_model="numpy", _nrt=False, fastmath=False)
 def _drift_column_call(jp, jv, j, mu, dt, kw):
     """``drift_column`` called, not inlined: the rare path kept out of the lockstep code."""
     dim = jp.shape[0]
     drift_column(jp, jv, j, mu, dt, kw[_RV_R, :dim], kw[_RV_V, :dim])
 
 
-@njit(cache=True, error_model="numpy", _nrt=False, fastmath={"contract"})
+@jit(error_model="numpy", _nrt=False, fastmath={"contract"})
 def drift_columns(jp, jv, first, count, mu, dt, kw, known=False):
     """Columns ``first`` to ``count`` of ``jp``, ``jv`` (dim, count) moved along their Kepler
     orbits about ``mu[j]`` for time dt, in place (mu[j] = 0: a straight line): the same

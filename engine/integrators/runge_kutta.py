@@ -6,18 +6,19 @@
 Four evaluations per step, fourth order, not symplectic: energy drifts slowly, linearly in time.
 """
 import numpy as np
-from numba import njit
+from ..cache import jit
 
 from ..forces.dispatch import accelerations
 from ..state import with_motion
-from .common import OK, active_mask, all_finite, first_nonfinite, hold_pinned, wrap_positions
+from .common import (OK, active_mask, all_finite, copy_state, first_nonfinite, hold_pinned,
+                     wrap_positions)
 
 NAME = "rk4"
 ORDER = 4
 FORCE_EVALUATIONS = 4
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _stage(pos, vel, dx, dv, c, n, out_pos, out_vel):
     """out = y + c * (dx, dv)."""
     for k in range(pos.shape[0]):
@@ -26,7 +27,7 @@ def _stage(pos, vel, dx, dv, c, n, out_pos, out_vel):
             out_vel[k, i] = vel[k, i] + c * dv[k, i]
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def advance(t, h, steps, state, model, work, vdep, t_end):
     pos = state.pos
     vel = state.vel
@@ -74,7 +75,6 @@ def advance(t, h, steps, state, model, work, vdep, t_end):
             if status >= 0:
                 return t, h, step, status
         wrap_positions(x2, mask, n, state.box)
-        pos[:, :n] = x2
-        vel[:, :n] = v2
+        copy_state(x2, v2, pos, vel, n)
         t = t0 + (step + 1) * h
     return t, h, steps, OK

@@ -20,7 +20,7 @@ A few bodies under gravity alone take the fused executor of ``fused_gravity`` in
 same operations, bit for bit, without the general machinery's cost per step.
 """
 import numpy as np
-from numba import njit
+from ..cache import jit
 
 from ..forces.dispatch import accelerations, accelerations_inline
 from . import fused_gravity
@@ -64,27 +64,35 @@ def force_evaluations(name):
     return kicks - (1 if starts_with_kick and ends_with_kick else 0)
 
 
-@njit(cache=True, inline="always")
+@jit(inline="always")
 def scratch_rows(dim):
     """Rows of the scratch ``advance_general_in`` needs for a system of dimension ``dim``: the
     accelerations, the saved positions and velocities (dim rows each) and the motion mask."""
     return 3 * dim + 1
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def advance(t, h, steps, state, model, work, vdep, t_end, drifts, kicks):
     """``steps`` steps of the scheme (drift ``drifts[k] h``, then kick ``kicks[k] h``)."""
     if fused_gravity.applies(state, model):
         f0 = model.param_offsets[0]
         return fused_gravity.advance(t, h, steps, state.pos, state.vel, state.mass, state.active,
                                      state.n, model.params[f0], model.params[f0 + 1], drifts, kicks)
+    return advance_general(t, h, steps, state, model, work, vdep, t_end, drifts, kicks)
+
+
+@jit(error_model="numpy")
+def advance_general(t, h, steps, state, model, work, vdep, t_end, drifts, kicks):
+    """``advance`` by the general executor alone: what a scene the fused executor cannot take
+    runs (chosen in Python by ``engine.integrators.advance``, so that such a scene never
+    compiles the fused executor)."""
     scratch = np.empty((scratch_rows(state.pos.shape[0]), state.n))
     # the force table called, not inlined: inlined into this loop it made a step of the Kepler
     # problem about 4x slower (475 against 122 ns, symplectic Euler, same bits)
     return _advance_general(t, h, steps, state, model, work, vdep, drifts, kicks, scratch, True)
 
 
-@njit(cache=True, error_model="numpy", _nrt=False, inline="always")
+@jit(error_model="numpy", _nrt=False, inline="always")
 def advance_general_in(t, h, steps, state, model, work, vdep, drifts, kicks, scratch):
     """``advance`` by the general executor alone (every term through the dispatch table; the
     fused path gives the same bits for the scenes it takes), in caller-owned ``scratch`` of
@@ -95,7 +103,7 @@ def advance_general_in(t, h, steps, state, model, work, vdep, drifts, kicks, scr
     return _advance_general(t, h, steps, state, model, work, vdep, drifts, kicks, scratch, False)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _advance_general(t, h, steps, state, model, work, vdep, drifts, kicks, scratch, call_forces):
     """The general executor, every declared force through the dispatch table: called
     (``call_forces``, a constant of each caller) or inlined into the loop, the same

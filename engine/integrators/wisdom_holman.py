@@ -46,7 +46,7 @@ import functools
 import math
 
 import numpy as np
-from numba import njit
+from ..cache import jit
 
 from ..forces.dispatch import EMPTY_MODEL, accelerations_inline
 from ..forces.gravity import NBodyGravity
@@ -121,7 +121,7 @@ def corrector_table(order):
 
 
 # -- coordinates ------------------------------------------------------------------------------
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _to_jacobi(pos, vel, m, order, count, jp, jv, eta):
     """Jacobi positions and velocities of the bodies ``order[:count]`` (the first is the
     centre) into ``jp``, ``jv`` (column j for order[j]; column 0 the centre of mass), and the
@@ -149,7 +149,7 @@ def _to_jacobi(pos, vel, m, order, count, jp, jv, eta):
         jv[k, 0] /= e
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _from_jacobi(jp, jv, m, order, count, eta, pos, vel, with_vel):
     """Inertial positions (and velocities) from Jacobi ones (the inverse of ``_to_jacobi``):
     with S_j the mass-weighted sum of the first j + 1 bodies, S_{j-1} = (S_j - m r'_j)
@@ -173,7 +173,7 @@ def _from_jacobi(jp, jv, m, order, count, eta, pos, vel, with_vel):
             vel[k, c] = sv / m[c]
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _jacobi_accelerations(acc, m, order, count, eta, ja):
     """The Jacobi transform of inertial accelerations (the same map as the positions')."""
     dim = acc.shape[0]
@@ -187,7 +187,7 @@ def _jacobi_accelerations(acc, m, order, count, eta, ja):
         ja[k, 0] = s / eta[count - 1]
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _to_democratic(pos, vel, m, order, count, jp, jv, eta):
     """Democratic heliocentric coordinates of the bodies ``order[:count]`` (the first is the
     centre): column 0 the centre of mass and its velocity, column j the position relative to
@@ -216,7 +216,7 @@ def _to_democratic(pos, vel, m, order, count, jp, jv, eta):
         eta[j] = total
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _from_democratic(jp, jv, m, order, count, eta, pos, vel, with_vel):
     """Inertial positions (and velocities) from democratic heliocentric ones: the centre at
     R - sum_j m_j Q_j / M, each body at Q_j from it; the bodies' velocities V + v_j and the
@@ -241,7 +241,7 @@ def _from_democratic(jp, jv, m, order, count, eta, pos, vel, with_vel):
                 vel[k, order[j]] = jv[k, j] + jv[k, 0]
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _jump(jp, jv, mo, count, massive, m0, h):
     """The democratic heliocentric jump: every heliocentric position moves by
     h sum_k m_k v_k / m_0 (the centre's kinetic term, Duncan, Levison & Lee 1998)."""
@@ -255,7 +255,7 @@ def _jump(jp, jv, mo, count, massive, m0, h):
             jp[k, j] += shift
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@jit(error_model="numpy", _nrt=False)
 def _democratic_interaction(t, jp, jv, state, kick_model, work, m, order, count, eta, mu, center,
                             acc, ja, kick_com, mo, massive, G, with_vel):
     """The interaction acceleration in democratic heliocentric coordinates: with gravity the
@@ -314,7 +314,7 @@ def _democratic_interaction(t, jp, jv, state, kick_model, work, m, order, count,
             ja[k, j] = acc[k, i] + f * jp[k, j] - ja[k, 0]
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@jit(error_model="numpy", _nrt=False)
 def _democratic_kick(t, h, jp, jv, state, kick_model, work, m, order, count, eta, mu, center,
                      acc, ja, kick_com, shifted, vdep, mo, massive, G):
     """jump(h/2) interaction(h) jump(h/2); velocity-dependent terms at the midpoint velocity,
@@ -337,7 +337,7 @@ def _democratic_kick(t, h, jp, jv, state, kick_model, work, m, order, count, eta
 
 
 # -- the two operators ------------------------------------------------------------------------
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _kepler_drift(mode, jp, jv, mu, count, h, kw, box):
     """Every moving body along its Kepler orbit for time h (mu[j] = 0: a straight line;
     ``kepler_drift.drift_columns``, ``kw`` its scratch); in JACOBI mode column 0, the centre
@@ -356,7 +356,7 @@ def _kepler_drift(mode, jp, jv, mu, count, h, kw, box):
                 jp[k, j] = wrap_scalar(jp[k, j], box)
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)  # one copy of the inlined force table
+@jit(error_model="numpy", _nrt=False)  # one copy of the inlined force table
 def _interaction(mode, t, jp, state, kick_model, work, m, order, count, eta, mu, center, acc,
                  ja, kick_com):
     """The acceleration of the interaction part at the current positions, per coordinate
@@ -385,7 +385,7 @@ def _interaction(mode, t, jp, state, kick_model, work, m, order, count, eta, mu,
                 ja[k, j] += s * jp[k, j]
 
 
-@njit(cache=True, error_model="numpy", _nrt=False, fastmath={"contract"})
+@jit(error_model="numpy", _nrt=False, fastmath={"contract"})
 def _gravity_interaction(jp, mo, count, massive, eta, mu, G, xs, ad, ja, kw):
     """JACOBI_GRAVITY mode's interaction acceleration (``_interaction``'s, for mutual
     gravity alone), on the coordinates' own columns: the inertial positions from the Jacobi
@@ -485,7 +485,7 @@ def _gravity_interaction(jp, mo, count, massive, eta, mu, G, xs, ad, ja, kw):
                 ja[k, j] += f * jp[k, j]
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _sync_positions(mode, jp, jv, m, order, count, eta, center, pos, vel, with_vel, box):
     """Inertial positions (and velocities) in ``pos``, ``vel`` from the coordinates."""
     dim = jp.shape[0]
@@ -503,7 +503,7 @@ def _sync_positions(mode, jp, jv, m, order, count, eta, center, pos, vel, with_v
                 vel[k, i] = jv[k, j]
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@jit(error_model="numpy", _nrt=False)
 def _kick(mode, t, h, jp, jv, state, kick_model, work, m, order, count, eta, mu, center, acc,
           ja, kick_com, kernel, shifted, vdep, mo, xs, ad, massive, G, kw):
     """v' += h a'_interaction; the lazy kernel evaluates a' at positions moved by
@@ -559,7 +559,7 @@ def _kick(mode, t, h, jp, jv, state, kick_model, work, m, order, count, eta, mu,
             jv[k, j] += h * ja[k, j]
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _kick_step(mode, t, h, jp, jv, state, kick_model, work, m, order, count, eta, mu, center,
                acc, ja, kick_com, kernel, shifted, vdep, mo, xs, ad, massive, G, kw):
     """``_kick``, with its two common cases taken without calling it: nothing to kick
@@ -580,7 +580,7 @@ def _kick_step(mode, t, h, jp, jv, state, kick_model, work, m, order, count, eta
           kick_com, kernel, shifted, vdep, mo, xs, ad, massive, G, kw)
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@jit(error_model="numpy", _nrt=False)
 def _corrector(table, sign, h, mode, t, jp, jv, state, kick_model, work, m, order, count, eta,
                mu, center, acc, ja, kick_com, kw, shifted, vdep, mo, xs, ad, massive, G):
     """The corrector (sign 1) or its inverse (sign -1): Z(a, b) = D(a) K(-b) D(-2a) K(b) D(a)
@@ -601,7 +601,7 @@ def _corrector(table, sign, h, mode, t, jp, jv, state, kick_model, work, m, orde
         _kepler_drift(mode, jp, jv, mu, count, a, kw, state.box)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _first_bad_column(jp, jv, count):
     for j in range(count):
         for k in range(jp.shape[0]):
@@ -610,7 +610,7 @@ def _first_bad_column(jp, jv, count):
     return 0
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _coordinates(mode, pos, vel, m, order, count, center, jp, jv, eta, box):
     dim = pos.shape[0]
     if mode == DEMOCRATIC:
@@ -626,7 +626,7 @@ def _coordinates(mode, pos, vel, m, order, count, center, jp, jv, eta, box):
             jv[k, j] = vel[k, i]
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def kepler_parameters(mode, m, order, count, eta, G, mu_attractor, attracted, mu):
     """mu per coordinate column: G eta_j in JACOBI mode (0 for the centre of mass), the
     attractor's mu for the particles it acts on in ATTRACTOR mode (else 0)."""
@@ -639,7 +639,7 @@ def kepler_parameters(mode, m, order, count, eta, G, mu_attractor, attracted, mu
             mu[j] = mu_attractor if attracted[order[j]] else 0.0
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@jit(error_model="numpy", _nrt=False)
 def _lazy_corrector(cc, h, mode, t, jp, jv, state, kick_model, work, m, order, count, eta, mu,
                     center, acc, ja, kick_com, shifted, ja0, vdep):
     """SABA's corrector exp(cc h^3 L_{{A,B},B}) by the lazy implementer's difference
@@ -667,7 +667,7 @@ def _lazy_corrector(cc, h, mode, t, jp, jv, state, kick_model, work, m, order, c
             jv[k, j] += f * (ja[k, j] - ja0[k, j])
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def advance(t, h, steps, state, kick_model, work, vdep, t_end, mode, order, m, G, mu_attractor,
             center, attracted, kick_com, kernel, corrector, drifts, kicks, cc):
     """``steps`` steps of ``h`` of the splitting ``drifts[0] kicks[0] drifts[1] ... kicks[S-1]
@@ -706,7 +706,7 @@ def advance(t, h, steps, state, kick_model, work, vdep, t_end, mode, order, m, G
                   first_v)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _save_columns(jp, jv, save_p, save_v, count):
     """The coordinates a step starts from, kept: a step that fails is undone from them."""
     for j in range(count):
@@ -720,7 +720,7 @@ def _save_columns(jp, jv, save_p, save_v, count):
 CHECKPOINT_STEPS = 64
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@jit(error_model="numpy", inline="always")
 def _gravity_step(jp, jv, mo, count, massive, eta, mu, G, xs, ad, ja, kw, kick, d):
     """One step of ``_gravity_steps``: the interaction's kick, then the drift ``d``."""
     dim = jp.shape[0]
@@ -733,7 +733,7 @@ def _gravity_step(jp, jv, mo, count, massive, eta, mu, G, xs, ad, ja, kw, kick, 
     drift_columns(jp, jv, 1, count, mu, d, kw, True)
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@jit(error_model="numpy", _nrt=False)
 def _gravity_steps(t, h, steps, jp, jv, save_p, save_v, mo, count, massive, eta, mu, G, xs, ad,
                    ja, kw, kick, merged, last):
     """``_steps``' loop for its most common case (mutual gravity alone, the standard kernel,
@@ -773,7 +773,7 @@ def _gravity_steps(t, h, steps, jp, jv, save_p, save_v, mo, count, massive, eta,
     return t, done, -1
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@jit(error_model="numpy", _nrt=False)
 def _free_steps(t, h, steps, jp, jv, save_p, save_v, count, mu, kw, merged, last, box):
     """``_steps``' loop when nothing is kicked (ATTRACTOR mode, the attractor the only term:
     test particles about a star, a lone Kepler orbit) and no corrector stands between steps:
@@ -800,7 +800,7 @@ def _free_steps(t, h, steps, jp, jv, save_p, save_v, count, mu, kw, merged, last
     return t, done, -1
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@jit(error_model="numpy", _nrt=False)
 def _steps(t, h, steps, state, kick_model, work, vdep, mode, order, m, G, mu_attractor, center,
            attracted, kick_com, kernel, corrector, drifts, kicks, cc, jp, jv, save_p, save_v,
            shifted, ja, ja0, eta, mu, acc, kw, mo, xs, ad, first_p, first_v):
@@ -996,7 +996,7 @@ DOMINANCE = 10.0
 _NO_MASSES = np.zeros(1)
 
 
-@njit(cache=True)
+@jit()
 def _attractor_columns(active, pinned, indices, n):
     """ATTRACTOR mode's columns in one compiled pass (a plan is made on a simulation's first
     call, where a dozen small numpy calls would cost more than the steps): the moving
@@ -1015,7 +1015,7 @@ def _attractor_columns(active, pinned, indices, n):
     return order[:count].copy(), attracted
 
 
-@njit(cache=True)
+@jit()
 def _jacobi_columns(active, pinned, test, mass, n):
     """JACOBI mode's columns in one compiled pass: ``(order, masses, heaviest, rest, massive,
     pinned_active)``: the heaviest moving body first (ties: the lowest index), the other

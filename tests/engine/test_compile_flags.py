@@ -14,14 +14,13 @@ first: 5 of 6 fused-against-general comparisons differed before the force table,
 ``root7`` and the drift's fallback declared ``fastmath=False``, none after. A test of that
 order would compile the integrators again in a subprocess, minutes of CI for one check.)
 """
-import dis
 import importlib
 import pkgutil
-import types
 
 from numba.core.registry import CPUDispatcher
 
 import engine
+from engine.cache import named_objects
 
 
 def _engine_dispatchers():
@@ -34,31 +33,11 @@ def _engine_dispatchers():
     return found
 
 
-def _code_objects(code):
-    yield code
-    for const in code.co_consts:  # comprehensions and nested functions
-        if isinstance(const, types.CodeType):
-            yield from _code_objects(const)
-
-
 def _named_dispatchers(dispatcher):
     """The compiled functions a function's code loads: globals (``root7``) and attributes of
-    the modules it loads (``dispatch.accelerations``), read from its bytecode."""
-    scope = dispatcher.py_func.__globals__
-    out = []
-    for code in _code_objects(dispatcher.py_func.__code__):
-        held = None
-        for ins in dis.get_instructions(code):
-            if ins.opname == "LOAD_GLOBAL":
-                held = scope.get(ins.argval)
-            elif ins.opname in ("LOAD_ATTR", "LOAD_METHOD") and isinstance(held, types.ModuleType):
-                held = getattr(held, ins.argval, None)
-            else:
-                held = None
-                continue
-            if isinstance(held, CPUDispatcher):
-                out.append(held)
-    return out
+    the modules it loads (``dispatch.accelerations``), read from its bytecode by the walk the
+    compiled-code cache keys its functions with (``engine.cache.named_objects``)."""
+    return [obj for obj in named_objects(dispatcher.py_func) if isinstance(obj, CPUDispatcher)]
 
 
 def _inlined(dispatcher):

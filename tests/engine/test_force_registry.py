@@ -1,11 +1,10 @@
-"""The force registry: every kind unique, declared once, and reaching both compiled dispatchers."""
+"""The force registry: every kind unique, declared once, and reached by the compiled table through its own kernels."""
 import numpy as np
 import pytest
 
 from engine import Simulation, forces
 from engine.forces import dispatch, registry
 from engine.forces.pairwise import workspace
-from engine.state import Model
 
 ENTRIES = registry.entries()
 
@@ -68,10 +67,11 @@ def test_each_kind_reaches_both_dispatchers_through_its_own_kernels(entry):
                         model.index_offsets[0], model.index_offsets[1])
     assert out[0] == u
     assert (u != 0.0) == entry.conservative  # only conservative terms have a potential
-    # a kind the registry does not know reaches neither
-    unknown = Model(np.array([99]), model.params, model.param_offsets, model.indices, model.index_offsets)
-    dispatch.accelerations(0.0, state, unknown, via_dispatch, work)
-    assert not via_dispatch.any()
+    # the table reaches the term through the addresses of this very module's kernels
+    assert tuple(model.accumulators) + tuple(model.potentials) == dispatch.kernel_addresses(entry.kind)
+    # a kind the registry does not know has no kernels to call
+    with pytest.raises(KeyError, match="99"):
+        dispatch.kernel_addresses(99)
 
 
 @pytest.mark.parametrize("entry", ENTRIES, ids=[e.name for e in ENTRIES])
