@@ -112,8 +112,10 @@ def main(argv=None):
     if "--" not in argv:
         argv = argv + ["--"] if argv else ["--help"]
     split = argv.index("--") if "--" in argv else len(argv)
-    parser = argparse.ArgumentParser(prog="python -m validation compile-times",
-                                     description=__doc__.split("\n\n")[0])
+    parser = argparse.ArgumentParser(
+        prog="python -m validation compile-times",
+        usage="%(prog)s [--out FILE.json] [--top N] [--note TEXT] -- MODULE [ARGS ...]",
+        description=__doc__.split("\n\n")[0])
     parser.add_argument("--out", help="write the measurement as JSON here")
     parser.add_argument("--top", type=int, default=30, help="rows of the table")
     parser.add_argument("--note", default="", help="a line kept with the measurement")
