@@ -80,7 +80,7 @@ def _ahead_dir():
     return os.path.join(cache.cache_dir(), "ahead")
 
 
-def _record_path(task):
+def record_path(task):
     return os.path.join(_ahead_dir(), f"{task.name}.json")
 
 
@@ -99,7 +99,7 @@ def _dispatcher(name):
 def fresh(task):
     """Has ``task`` run with the current sources (its record's stamps all current)?"""
     try:
-        with open(_record_path(task), encoding="utf-8") as f:
+        with open(record_path(task), encoding="utf-8") as f:
             record = json.load(f)
     except (OSError, ValueError):
         return False
@@ -152,7 +152,7 @@ def _work(task):
     target = getattr(importlib.import_module(module_name), function)
     entered = _entered(lambda: target(*task.args))
     os.makedirs(_ahead_dir(), exist_ok=True)
-    atomic_write(_record_path(task), json.dumps({"args": list(task.args), "entered": entered},
+    atomic_write(record_path(task), json.dumps({"args": list(task.args), "entered": entered},
                                                 sort_keys=True))
     return time.perf_counter() - start
 

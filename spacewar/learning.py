@@ -72,8 +72,12 @@ def slots_in_flight(torpedoes, life, reload):
 
 
 def torpedo_slots(rules):
-    """S, the learning observation's torpedo slots per ship under these rules."""
-    return int(slots_in_flight(rules.torpedoes, rules.torpedo_life, rules.reload))
+    """S, the learning observation's torpedo slots per ship under these rules.
+
+    The same formula as the compiled code's, run by Python: reading a policy file validates
+    its layout through this, and need not start numba's JIT (about 48 MiB resident) to do so."""
+    return int(slots_in_flight.py_func(int(rules.torpedoes), int(rules.torpedo_life),
+                                       int(rules.reload)))
 
 
 def learning_length(rules):

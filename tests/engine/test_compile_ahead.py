@@ -23,7 +23,7 @@ def test_a_task_runs_once_and_is_then_fresh(cold_cache, capsys):
     done = compile_ahead.run([EULER], jobs=1)
     assert list(done) == ["tour-euler"] and done["tour-euler"] > 0.0
     assert compile_ahead.fresh(EULER)
-    with open(compile_ahead._record_path(EULER), encoding="utf-8") as f:
+    with open(compile_ahead.record_path(EULER), encoding="utf-8") as f:
         record = json.load(f)
     # what the task entered from Python, each with the stamp of the sources it is built from
     from engine import cache
@@ -35,7 +35,7 @@ def test_a_task_runs_once_and_is_then_fresh(cold_cache, capsys):
 
     # a source of one of them changed: the record's stamp is no longer the current one
     record["entered"]["engine.integrators.euler:advance"] = "0" * 64
-    with open(compile_ahead._record_path(EULER), "w", encoding="utf-8") as f:
+    with open(compile_ahead.record_path(EULER), "w", encoding="utf-8") as f:
         json.dump(record, f)
     assert not compile_ahead.fresh(EULER)
 
@@ -44,7 +44,7 @@ def test_a_task_runs_once_and_is_then_fresh(cold_cache, capsys):
 
 
 def test_a_record_of_other_arguments_or_garbage_is_not_fresh(cold_cache):
-    path = compile_ahead._record_path(EULER)
+    path = compile_ahead.record_path(EULER)
     (cold_cache / "compiled" / "ahead").mkdir(parents=True)
     for text in ("not json", "[]", json.dumps({"args": ["rk4"], "entered": {"x:y": "0"}}),
                  json.dumps({"args": ["euler"], "entered": {}}),
