@@ -51,13 +51,25 @@ jit = compiler("spacewar")
 # The ones called every frame are also inlined (``inline="always"``): a call passes each
 # array as ten words, and one with a dozen arrays measured 25 to 165 ns, against about
 # 300 ns for a whole idle match-frame once inlined.
+#
+# The frame itself (``step_match``) is compiled once, on its own, and inlined into its three
+# callers (``step_all``, ``step_one_and_observe``, ``learning.step_learning``) by LLVM
+# (``forceinline``: the same machine code as numba's inlining, no call per match): numba's
+# inlining re-derives and deep-copies a callee's IR at every call site, in time that grows
+# with the square of its size, and compiled each caller's copy of the frame in full. The
+# helpers that only compiled code calls have no Python entry points
+# (``no_cpython_wrapper``, ``no_cfunc_wrapper``; calling one from Python would crash), which
+# numba would otherwise generate and optimise for each; ``forceinline=False`` keeps the cold
+# ones called even when compiled from within the frame (numba passes a caller's
+# ``forceinline`` on to the callees it compiles).
+_CALLED = dict(_nrt=False, forceinline=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 
 _GOLDEN = np.uint64(0x9E3779B97F4A7C15)
 _MIX1 = np.uint64(0xBF58476D1CE4E5B9)
 _MIX2 = np.uint64(0x94D049BB133111EB)
 
 
-@jit(_nrt=False)
+@jit(**_CALLED)
 def next_u64(rng, m):
     """splitmix64 (Steele, Lea & Flood 2014): the next 64 random bits of match m's stream."""
     z = rng[m] + _GOLDEN
@@ -67,7 +79,7 @@ def next_u64(rng, m):
     return z ^ (z >> np.uint64(31))
 
 
-@jit(_nrt=False)
+@jit(**_CALLED)
 def uniform(rng, m):
     """A float in [0, 1) with 53 random bits."""
     return float(next_u64(rng, m) >> np.uint64(11)) * (1.0 / 9007199254740992.0)
@@ -79,7 +91,7 @@ def wrap(x):
     return space.wrap_scalar(x, 1.0)
 
 
-@jit()
+@jit(**_CALLED)
 def ship_start(s, rules):
     """Start position and heading: opposite corners of the star, each facing the other's side."""
     d = rules[R_START] / math.sqrt(2.0)
@@ -88,7 +100,7 @@ def ship_start(s, rules):
     return d, -d, 0.5 * math.pi
 
 
-@jit(_nrt=False)
+@jit(**_CALLED)
 def reset_round(m, pos, vel, mass, charge, active, ship_gauges, ship_counters, torp_life, match_state, rules):
     """Ships back to their start, full stores, torpedoes cleared."""
     ntorp = int(rules[R_NTORP])
@@ -125,7 +137,7 @@ def reset_round(m, pos, vel, mass, charge, active, ship_gauges, ship_counters, t
     match_state[m, END_TIMER] = -1
 
 
-@jit(_nrt=False)
+@jit(**_CALLED)
 def _kill_ship(m, s, active, ship_counters, frame):
     if ship_counters[m, s, ALIVE] == 1:
         ship_counters[m, s, ALIVE] = 0
@@ -134,7 +146,7 @@ def _kill_ship(m, s, active, ship_counters, frame):
         active[m, s] = False
 
 
-@jit(_nrt=False)
+@jit(**_CALLED)
 def _fire(m, s, pos, vel, mass, charge, active, ship_gauges, ship_counters, torp_life, rules):
     ntorp = int(rules[R_NTORP])
     k = ntorp - ship_counters[m, s, TORPS]  # each torpedo of a round has its own slot
@@ -154,7 +166,7 @@ def _fire(m, s, pos, vel, mass, charge, active, ship_gauges, ship_counters, torp
     ship_counters[m, s, RELOAD] = int(rules[R_RELOAD])
 
 
-@jit(_nrt=False)
+@jit(**_CALLED)
 def _reenter(m, s, pos, vel, active, ship_gauges, ship_counters, rng, rules):
     """Back from hyperspace at a random place, speed and heading; jump k breaks up with k/8."""
     ship_counters[m, s, IN_HYPER] = 0
@@ -392,7 +404,7 @@ def _move(m, state, model, work, drifts, kicks, scratch):
     return status, count
 
 
-@jit(_nrt=False, inline="always")
+@jit(_nrt=False, forceinline=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def step_match(m, actions, state, model, work, ship_gauges, ship_counters, torp_life,
                match_state, rng, rules, drifts, kicks, scratch):
     """Advance match ``m`` by one frame with ``actions[m, 0]`` and ``actions[m, 1]``.
@@ -486,7 +498,7 @@ def step_one_and_observe(actions, pos, vel, mass, charge, radius, active, test, 
                           torp_life, match_state, rules, raws[seat])
 
 
-@jit()
+@jit(**_CALLED)
 def reset_match(m, pos, vel, mass, charge, active, ship_gauges, ship_counters, torp_life,
                 match_state, rules):
     """Match m back to its first frame (its random stream is the caller's to set)."""

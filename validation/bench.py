@@ -399,6 +399,38 @@ def stored_compile_times():
     return found
 
 
+def compile_time_markdown(stored):
+    """Markdown lines for the stored compile-time measurements: one row per command with its
+    totals after and before the change (``NAME.json`` and ``NAME.before.json``), then each
+    command's longest compiles after it, and before it."""
+    from .compile_times import format_table
+
+    after = {k: v for k, v in stored.items() if not k.endswith(".before")}
+    if not after:
+        return []
+
+    def totals(m):
+        return (f"{m['compile_seconds']:.1f} s in {len(m['functions'])} functions "
+                f"({m['compilations']} compilations)")
+
+    out = ["### What each command compiles, from an empty cache", "",
+           "CPU seconds of compiling in one process (`python -m validation compile-times`; "
+           "compiling ahead off), exclusive of the callees compiled inside each function.", "",
+           "| command | before | after |", "|---|---|---|"]
+    for name, m in after.items():
+        before = stored.get(name + ".before")
+        out.append(f"| `python -m {' '.join(m['command'])}` | "
+                   f"{totals(before) if before else 'not measured'} | {totals(m)} |")
+    out.append("")
+    for name, m in after.items():
+        out += [f"#### `python -m {' '.join(m['command'])}`", "", m.get("note", ""), "",
+                format_table(m, top=25), ""]
+        before = stored.get(name + ".before")
+        if before:
+            out += [f"Before ({before.get('note', '')}):", "", format_table(before, top=10), ""]
+    return out
+
+
 # -- 6. Spacewar -------------------------------------------------------------------------------
 def bench_spacewar(matches=256, frames=2000, repeats=5):
     from spacewar import Game, Rules
@@ -1108,12 +1140,7 @@ def format_markdown(r, command):
                        f"{row['warm_seconds']:.2f} | {row['cold_seconds']:.1f} | "
                        f"{row['cold_seconds'] - row['warm_seconds']:.1f} |")
         out.append("")
-    for name, measured in r.get("compile_times", {}).items():
-        from .compile_times import format_table
-
-        out += [f"### What `python -m {' '.join(measured['command'])}` compiles, from an empty "
-                "cache", "",
-                measured.get("note", ""), "", format_table(measured, top=25), ""]
+    out += compile_time_markdown(r.get("compile_times", {}))
     if "spacewar" in r:
         s = r["spacewar"]
         one = s["one_match_with_bots"]
