@@ -247,6 +247,7 @@ def _cache_classes():
 
         def __init__(self, py_func, py_file):
             self._py_func = py_func
+            self._py_file = py_file  # numba's warning about an uncachable function names it
             self._lineno = py_func.__code__.co_firstlineno
             self._path = os.path.join(cache_dir(), self.get_suitable_cache_subpath(py_file))
 

@@ -349,7 +349,7 @@ def _kepler_drift(mode, jp, jv, mu, count, h, kw, box):
     if mode != ATTRACTOR:
         for k in range(dim):
             jp[k, 0] += h * jv[k, 0]
-    drift_columns(jp, jv, first, count, mu, h, kw)
+    drift_columns(jp, jv, first, count, mu, h, kw, False)  # one specialisation for both calls
     if box > 0.0:
         for j in range(first, count):
             for k in range(dim):

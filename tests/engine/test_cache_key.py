@@ -183,3 +183,29 @@ def test_earlier_versions_directories_are_pruned_when_unused_for_a_day(tmp_path)
     os.utime(ours, (day_ago, day_ago))
     cache.prune_legacy(str(tmp_path))
     assert not old.exists() and recent.exists() and ours.exists()
+
+
+def test_a_function_numba_cannot_cache_runs_with_numbas_warning(tmp_path, monkeypatch):
+    """A ctypes call puts a raw address in the code (a dynamic global): numba cannot cache
+    it and says so, naming the file; the function still runs (the warning once named a file
+    our locator did not keep, and raised AttributeError instead)."""
+    import ctypes
+    import warnings
+
+    from numba.core.errors import NumbaWarning
+
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
+    labs = ctypes.CDLL(None).labs
+    labs.argtypes, labs.restype = [ctypes.c_long], ctypes.c_long
+    monkeypatch.setitem(globals(), "_LABS", labs)  # a global: numba pickles a closure's cells
+    compiled = cache.jit()(_absolute)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        assert compiled(-7) == 7
+    messages = [str(w.message) for w in caught if issubclass(w.category, NumbaWarning)]
+    assert any('Cannot cache compiled function "_absolute"' in m for m in messages), messages
+    assert any(w.filename == __file__ for w in caught)
+
+
+def _absolute(x):
+    return _LABS(x)  # noqa: F821 (set by the test above)
