@@ -107,8 +107,13 @@ def _project_file(obj):
     module = obj if isinstance(obj, pytypes.ModuleType) else sys.modules.get(
         getattr(obj, "__module__", None) or "")
     path = getattr(module, "__file__", None)
-    if not path:
-        return None
+    return _project_path(path) if path else None
+
+
+@functools.lru_cache(maxsize=None)
+def _project_path(path):
+    """``path`` resolved if it lies in one of this project's packages, else None (asked for
+    every object every compiled function names: once per file)."""
     path = Path(path).resolve()
     return path if any(_ROOT / package in path.parents for package in SOURCES) else None
 
@@ -236,6 +241,18 @@ def dependency_stamp(function):
     return digest.hexdigest()
 
 
+#: a symbol of numba's thread pool (``numba.np.ufunc.parallel``), in the machine code of every
+#: function that runs a ``prange`` loop or links one
+_THREAD_POOL_SYMBOL = b"allocate_sched"
+
+
+def _calls_thread_pool(libdata):
+    """Whether a cached library (numba's ``(name, kind, data)``) calls the thread pool."""
+    _, kind, data = libdata
+    code = data[0] if kind == "object" else data
+    return isinstance(code, (bytes, bytearray)) and _THREAD_POOL_SYMBOL in code
+
+
 # -- numba's cache, keyed on the dependencies ------------------------------------------------
 @functools.lru_cache(maxsize=None)
 def _cache_classes():
@@ -266,7 +283,28 @@ def _cache_classes():
             return cls(py_func, py_file)
 
     class Impl(CompileResultCacheImpl):
+        """numba's cache of compile results, with its parallel code made to start.
+
+        A function using ``prange`` runs its start-up (numba's thread pool, whose symbols
+        its machine code calls) before it is loaded from the cache; a function that calls it
+        links its code, and inherits that start-up when the callee was compiled in the same
+        process, but not when the callee was loaded from the cache (numba's library of a
+        loaded function forgets it). With each function cached on its own sources, a caller
+        is often recompiled while its callees load from the cache: its cached code then
+        aborted the next process that loaded it first ("LLVM ERROR: Symbol not found:
+        allocate_sched", measured). So a loaded function's library keeps its start-up for
+        its callers, and code that calls the thread pool starts it whatever its entry says."""
         _locator_classes = [Locator]
+
+        def rebuild(self, target_context, payload):
+            libdata, reload_init = payload[0], payload[7]
+            if not reload_init and _calls_thread_pool(libdata):
+                from numba.np.ufunc.parallel import _launch_threads
+
+                _launch_threads()
+            compiled = super().rebuild(target_context, payload)
+            compiled.library._reload_init.update(compiled.reload_init)
+            return compiled
 
     class DependencyCache(FunctionCache):
         """numba's function cache, its index stamped with ``dependency_stamp``: an edit to

@@ -22,6 +22,7 @@ processes write numba's cache at once.
 is asked for.
 """
 import fcntl
+import functools
 import hashlib
 import os
 import tempfile
@@ -121,7 +122,7 @@ class Connection:
             raise SchedulerUnreachable(
                 f"the Dask scheduler at {address!r} has had no worker for {WORKER_WAIT} s: start "
                 f"some with 'dask worker {address}' (docs/cluster.md)") from None
-        self.client.register_plugin(WarmWorker(code_fingerprint(), tuple(warm)),
+        self.client.register_plugin(_warm_worker_class()(code_fingerprint(), tuple(warm)),
                                     name="nbody-spacewar-warm")
 
     def workers(self):
@@ -211,21 +212,33 @@ def warm_up(names):
             fcntl.flock(lock, fcntl.LOCK_UN)
 
 
-def _plugin_base():
+@functools.lru_cache(maxsize=None)
+def _warm_worker_class():
+    """``WarmWorker``, made on first use: its base class is Dask's ``WorkerPlugin``, and
+    importing ``distributed`` takes 0.8 s, which every command that only names this module's
+    exceptions (``spacewar``'s command line does) would pay at start-up."""
     try:
-        from distributed.diagnostics.plugin import WorkerPlugin
+        from distributed.diagnostics.plugin import WorkerPlugin as base
     except ImportError:  # without the extra the class is never registered
-        return object
-    return WorkerPlugin
+        base = object
+
+    class WarmWorker(base):
+        """Worker plugin: refuse other code, then warm up (``warm_up``) before any task."""
+
+        def __init__(self, fingerprint, names):
+            self.fingerprint = fingerprint
+            self.names = tuple(names)
+
+        def setup(self, worker):
+            check_code(self.fingerprint)
+            warm_up(self.names)
+
+    WarmWorker.__module__ = __name__
+    WarmWorker.__qualname__ = "WarmWorker"  # pickled by reference: engine.cluster.WarmWorker
+    return WarmWorker
 
 
-class WarmWorker(_plugin_base()):
-    """Worker plugin: refuse other code, then warm up (``warm_up``) before any task."""
-
-    def __init__(self, fingerprint, names):
-        self.fingerprint = fingerprint
-        self.names = tuple(names)
-
-    def setup(self, worker):
-        check_code(self.fingerprint)
-        warm_up(self.names)
+def __getattr__(name):
+    if name == "WarmWorker":
+        return _warm_worker_class()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -22,8 +22,9 @@ import functools
 
 import numpy as np
 from numba import types
-from numba.core.errors import TypingError
 from numba.extending import intrinsic
+
+from ..address_calls import call_at, check_call, entry_address
 
 _F8_1D = types.Array(types.float64, 1, "C")
 _F8_2D = types.Array(types.float64, 2, "C")
@@ -49,37 +50,16 @@ def argument_types():
     return head + (_F8_2D, work), head
 
 
-def _checked(given, wanted, what):
-    """Refuse, at compile time, a call whose arguments are not of the kernels' types (an
-    indirect call cannot convert them)."""
-    if len(given) != len(wanted):
-        raise TypingError(f"{what} takes {len(wanted)} arguments, got {len(given)}")
-    for k, (g, w) in enumerate(zip(given, wanted)):
-        if g != w and not (isinstance(w, types.Integer) and isinstance(g, types.Integer)) \
-                and not (w == types.float64 and isinstance(g, (types.Float, types.Integer))):
-            raise TypingError(f"{what}: argument {k} is {g}, the kernels take {w}")
-
-
-def _indirect_call(context, builder, address, restype, argtypes, given, args):
-    """Call the compiled function at ``address`` (numba's calling convention) with ``args``
-    cast to ``argtypes``."""
-    args = [context.cast(builder, a, g, w) for a, g, w in zip(args, given, argtypes)]
-    fnty = context.call_conv.get_function_type(restype, argtypes)
-    pointer = builder.inttoptr(address, fnty.as_pointer())
-    _, value = context.call_conv.call_function(builder, pointer, restype, argtypes, args)
-    return value
-
-
 @intrinsic
 def call_accumulate(typingctx, address, t, state, params, f0, f1, indices, i0, i1, acc, work):
     """``accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work)`` of the kernel at
     ``address`` (an int64 from ``accumulate_address``)."""
     given = (t, state, params, f0, f1, indices, i0, i1, acc, work)
     wanted = argument_types()[0]
-    _checked(given, wanted, "call_accumulate")
+    check_call(given, wanted, "call_accumulate")
 
     def codegen(context, builder, signature, args):
-        _indirect_call(context, builder, args[0], types.none, wanted, given, args[1:])
+        call_at(context, builder, args[0], types.none, wanted, given, args[1:])
         return context.get_dummy_value()
     return types.none(address, *given), codegen
 
@@ -90,33 +70,24 @@ def call_potential(typingctx, address, t, state, params, f0, f1, indices, i0, i1
     (from ``potential_address``): the term's potential energy."""
     given = (t, state, params, f0, f1, indices, i0, i1)
     wanted = argument_types()[1]
-    _checked(given, wanted, "call_potential")
+    check_call(given, wanted, "call_potential")
 
     def codegen(context, builder, signature, args):
-        return _indirect_call(context, builder, args[0], types.float64, wanted, given, args[1:])
+        return call_at(context, builder, args[0], types.float64, wanted, given, args[1:])
     return types.float64(address, *given), codegen
-
-
-def _address(dispatcher, signature):
-    """Compile (or load from the cache) ``dispatcher`` for ``signature``; its entry address."""
-    compiled = dispatcher.overloads.get(signature)
-    if compiled is None:
-        dispatcher.compile(signature)
-        compiled = dispatcher.overloads[signature]
-    return compiled.library.get_pointer_to_function(compiled.fndesc.llvm_func_name)
 
 
 @functools.lru_cache(maxsize=None)
 def accumulate_address(module):
     """The address of ``module.accumulate`` compiled for the kernels' signature (compiled on
     the first call in a process, or loaded from the compiled-code cache)."""
-    return _address(module.accumulate, types.none(*argument_types()[0]).args)
+    return entry_address(module.accumulate, types.none(*argument_types()[0]))
 
 
 @functools.lru_cache(maxsize=None)
 def potential_address(module):
     """The address of ``module.potential`` compiled for the kernels' signature."""
-    return _address(module.potential, types.float64(*argument_types()[1]).args)
+    return entry_address(module.potential, types.float64(*argument_types()[1]))
 
 
 __all__ = ["argument_types", "call_accumulate", "call_potential", "accumulate_address",

@@ -88,13 +88,19 @@ import math
 from fractions import Fraction
 
 import numpy as np
+from llvmlite import ir
+from numba import types
+from numba.core import cgutils
+from numba.extending import intrinsic
+from numba.np.arrayobj import populate_array
+
 from ..cache import jit
 
 from ..forces.dispatch import accelerations
 from . import fused_gravity
 from ..state import with_motion
 from ..space import wrap_scalar
-from .common import OK, STEP_COLLAPSED, TIME_OVERFLOW, active_mask
+from .common import OK, STEP_COLLAPSED, TIME_OVERFLOW, fill_active_mask
 
 NAME = "ias15"
 ORDER = 15
@@ -221,22 +227,89 @@ def _views(memory, dim, n):
     terms as ``(dim n,)``, the state at the last return as ``(dim, n)``."""
     m = dim * n
     o = HEADER
-    b = memory[o:o + 7 * m].reshape((7, m))
+    b = _matrix(memory, o, 7, m)
     o += 7 * m
-    e = memory[o:o + 7 * m].reshape((7, m))
+    e = _matrix(memory, o, 7, m)
     o += 7 * m
-    b_done = memory[o:o + 7 * m].reshape((7, m))
+    b_done = _matrix(memory, o, 7, m)
     o += 7 * m
-    e_done = memory[o:o + 7 * m].reshape((7, m))
+    e_done = _matrix(memory, o, 7, m)
     o += 7 * m
     csx = memory[o:o + m]
     o += m
     csv = memory[o:o + m]
     o += m
-    x_end = memory[o:o + m].reshape((dim, n))
+    x_end = _matrix(memory, o, dim, n)
     o += m
-    v_end = memory[o:o + m].reshape((dim, n))
+    v_end = _matrix(memory, o, dim, n)
     return b, e, b_done, e_done, csx, csv, x_end, v_end
+
+
+# -- arrays without reference counting ------------------------------------------------------------
+#: every kernel of this module is compiled without reference counting (``_nrt=False``): with
+#: it, ``advance``, which allocates its scratch, paid reference-count updates for each of its
+#: thirty arrays on every path (750 calls in its code: seconds of compiling), and the steps
+#: could not run in it (each array passed to an inlined helper at a node paid atomic
+#: updates). These make and free its arrays instead.
+_MATRIX = types.Array(types.float64, 2, "C")
+
+
+@intrinsic
+def _scratch(typingctx, rows, columns):
+    """A ``(rows, columns)`` float64 array from numba's allocator (``NRT_Allocate``), without
+    a reference count, to be freed with ``_release``. MemoryError if none is left."""
+    def codegen(context, builder, signature, args):
+        rows, columns = args
+        itemsize = context.get_constant(types.intp, 8)
+        count = builder.mul(rows, columns)
+        one = context.get_constant(types.intp, 1)
+        count = builder.select(builder.icmp_signed("<", count, one), one, count)
+        allocate = cgutils.get_or_insert_function(
+            builder.module, ir.FunctionType(cgutils.voidptr_t, [cgutils.intp_t]),
+            "NRT_Allocate")
+        data = builder.call(allocate, [builder.mul(count, itemsize)])
+        with builder.if_then(cgutils.is_null(builder, data), likely=False):
+            context.call_conv.return_user_exc(builder, MemoryError,
+                                              ("ias15: no memory for the scratch arrays",))
+        array = context.make_array(_MATRIX)(context, builder)
+        populate_array(array, data=builder.bitcast(data, array.data.type),
+                       shape=[rows, columns], strides=[builder.mul(columns, itemsize), itemsize],
+                       itemsize=itemsize, meminfo=None)
+        return array._getvalue()
+    return _MATRIX(types.intp, types.intp), codegen
+
+
+@intrinsic
+def _matrix(typingctx, vector, start, rows, columns):
+    """``vector[start:start + rows columns].reshape((rows, columns))`` for a C-contiguous
+    float64 vector, without ``reshape``'s checks (the callers size their views; a reshape
+    compiles to a call, a check and an error path, and there were nine)."""
+    if not (isinstance(vector, types.Array) and vector.ndim == 1 and vector.layout == "C"
+            and vector.dtype == types.float64):
+        return None
+
+    def codegen(context, builder, signature, args):
+        vector, start, rows, columns = args
+        itemsize = context.get_constant(types.intp, 8)
+        data = context.make_array(signature.args[0])(context, builder, vector).data
+        view = context.make_array(_MATRIX)(context, builder)
+        populate_array(view, data=builder.gep(data, [start], inbounds=True),
+                       shape=[rows, columns], strides=[builder.mul(columns, itemsize), itemsize],
+                       itemsize=itemsize, meminfo=None)
+        return view._getvalue()
+    return _MATRIX(vector, types.intp, types.intp, types.intp), codegen
+
+
+@intrinsic
+def _release(typingctx, array):
+    """Free an array from ``_scratch``."""
+    def codegen(context, builder, signature, args):
+        data = context.make_array(signature.args[0])(context, builder, args[0]).data
+        free = cgutils.get_or_insert_function(
+            builder.module, ir.FunctionType(ir.VoidType(), [cgutils.voidptr_t]), "NRT_Free")
+        builder.call(free, [builder.bitcast(data, cgutils.voidptr_t)])
+        return context.get_dummy_value()
+    return types.void(array), codegen
 
 
 # -- small pieces ---------------------------------------------------------------------------------
@@ -277,41 +350,44 @@ def _first_bad(a, mask, n):
     return -1
 
 
-@jit(error_model="numpy", inline="always")
-def _predict(b_done, e_done, b, e, ratio, w):
-    """Everhart's predictor: the b, e for a step ``ratio`` times the last accepted one
-    (``w``: scratch of one row)."""
-    if not (abs(ratio) <= _NO_PREDICTION):
-        b[:] = 0.0
-        e[:] = 0.0
-        return
+@jit(error_model="numpy", _nrt=False, fastmath={"contract"}, no_cpython_wrapper=True,
+     no_cfunc_wrapper=True)
+def _predict(b_done, e_done, b, e, ratio, cold):
+    """Everhart's predictor: the b, e for a step ``ratio`` times the last accepted one;
+    ``cold`` (no step accepted yet): the same acceleration polynomial b over a step
+    ``ratio`` times as long (same start), e untouched.
+
+    One pass over the components, the sums over the coefficients inside it (the same
+    operations in the same order as a loop over the components per coefficient, which
+    compiled to 28 vector loops: 4800 lines of IR, a second of compiling, and 490 ns a call
+    for the outer solar system against 310 ns now)."""
     m = b.shape[1]
-    qj = 1.0
-    for j in range(7):
-        qj *= ratio
-        for c in range(m):
-            w[c] = 0.0
-        for k in range(6, j - 1, -1):
-            f = _BINOM[j, k]
+    if not (abs(ratio) <= _NO_PREDICTION):
+        for j in range(7):
             for c in range(m):
-                w[c] += f * b_done[k, c]
+                b[j, c] = 0.0
+        if not cold:
+            for j in range(7):
+                for c in range(m):
+                    e[j, c] = 0.0
+        return
+    if cold:
         for c in range(m):
-            ej = qj * w[c]
+            f = 1.0
+            for j in range(7):
+                f *= ratio
+                b[j, c] *= f
+        return
+    for c in range(m):
+        qj = 1.0
+        for j in range(7):
+            qj *= ratio
+            s = 0.0
+            for k in range(6, j - 1, -1):
+                s += _BINOM[j, k] * b_done[k, c]
+            ej = qj * s
             e[j, c] = ej
             b[j, c] = ej + (b_done[j, c] - e_done[j, c])
-
-
-@jit(error_model="numpy", inline="always")
-def _rescale(b, ratio):
-    """The same acceleration polynomial over a step ``ratio`` times as long (same start)."""
-    if not (abs(ratio) <= _NO_PREDICTION):
-        b[:] = 0.0
-        return
-    f = 1.0
-    for j in range(7):
-        f *= ratio
-        for c in range(b.shape[1]):
-            b[j, c] *= f
 
 
 @jit(error_model="numpy", inline="always")
@@ -376,10 +452,14 @@ def _forces(t, state, model, acc, work, fused):
 @jit(error_model="numpy", inline="always")
 def _horner(b, weights, s, w, m):
     """w = sum_j weights[j] b_j s^j for every component (Horner in s, one vector loop per
-    coefficient): the position (``_XINV``) or velocity (``_VINV``) polynomial at a node."""
+    coefficient): the velocity polynomial at a node (``_VINV``). The loop over the
+    coefficients runs to ``b.shape[0]`` (7), a bound the compiler does not see: with the
+    constant it unrolled the loop into seven vector loops. (Written out per component as in
+    ``_positions_at``, the multiply-adds fuse differently: other round-off.)"""
+    top = b.shape[0] - 1
     for c in range(m):
-        w[c] = b[6, c] * weights[6]
-    for j in range(5, -1, -1):
+        w[c] = b[top, c] * weights[top]
+    for j in range(top - 1, -1, -1):
         f = weights[j]
         for c in range(m):
             w[c] = w[c] * s + b[j, c] * f
@@ -418,11 +498,18 @@ def _positions_at(b, s, sdt, x0, v0, a0, csx, sx, m):
         sx[c] = x0[c] + (sdt * (v0[c] + sdt * (p * s + 0.5 * a0[c])) - csx[c])
 
 
-@jit(error_model="numpy", inline="always")
-def _iterate(t, dt, state, model, work, vdep, mask, a0, v0, x0, u0, b, csx, csv, g, csb, acc,
-             sx, sv, w, change, fused):
-    """The predictor-corrector on one step attempt. Returns (status, iterations, evaluations):
-    status -1, or the first moving particle with a non-finite acceleration at a node.
+@jit(error_model="numpy", _nrt=False, fastmath={"contract"}, no_cpython_wrapper=True,
+     no_cfunc_wrapper=True)
+def _advance(t, dt, state, model, work, vdep, fused, mask, a0, v0, x0, u0, b, csx, csv, g, csb,
+             acc, sx, sv, w, change, nx, ncx, nv, ncv):
+    """One step attempt of ``advance``: the predictor-corrector, then the positions and
+    velocities at the end of the step (``nx``, ``nv``, with their compensation terms ``ncx``,
+    ``ncv``). Returns (status, iterations, evaluations): status -1, or the first moving
+    particle with a non-finite acceleration at a node or a non-finite end value.
+
+    Compiled on its own and called once per step attempt: ``advance`` keeps the control
+    flow, this function the work (compiled into ``advance``, it made one function too large
+    for numba's inlining and SSA passes, which grow faster than its size).
 
     Every per-component array is flat, the components in (k, i) order (``_views``): ``acc``,
     ``sx`` and ``sv`` are flat views of the ``(dim, n)`` arrays the forces write and read,
@@ -444,8 +531,8 @@ def _iterate(t, dt, state, model, work, vdep, mask, a0, v0, x0, u0, b, csx, csv,
     n = state.n
     dim = pos.shape[0]
     m = dim * n
-    acc2d = acc.reshape((dim, n))
-    sub = with_motion(state, sx.reshape((dim, n)), sv.reshape((dim, n)))
+    acc2d = _matrix(acc, 0, dim, n)
+    sub = with_motion(state, _matrix(sx, 0, dim, n), _matrix(sv, 0, dim, n))
     for k in range(dim):
         for i in range(n):
             x0[k * n + i] = pos[k, i]
@@ -453,27 +540,25 @@ def _iterate(t, dt, state, model, work, vdep, mask, a0, v0, x0, u0, b, csx, csv,
     for c in range(m):
         sx[c] = x0[c]
         sv[c] = u0[c]
-    # g from b: g_j = sum_{l>=j} D[l, j] b_l; the b's compensation terms start at 0
-    for j in range(7):
-        for c in range(m):
-            w[c] = b[j, c]
-        for l in range(j + 1, 7):
-            d = _D[l, j]
-            for c in range(m):
-                w[c] += d * b[l, c]
-        for c in range(m):
-            g[j, c] = w[c]
+    # g from b: g_j = sum_{l>=j} D[l, j] b_l; the b's compensation terms start at 0. Here and
+    # at the end of the step the sums over the coefficients run inside one pass over the
+    # components (as in ``_predict``: the same operations in the same order, straight-line
+    # code in one loop instead of 28 and 7 loops)
+    for c in range(m):
+        for j in range(7):
+            gj = b[j, c]
+            for l in range(j + 1, 7):
+                gj += _D[l, j] * b[l, c]
+            g[j, c] = gj
             csb[j, c] = 0.0
     error = 1e300
     error_last = 2.0
     iterations = 0
     evaluations = 0
     while True:
-        if error < _CONVERGED:
-            break
-        if iterations > 2 and error_last <= error:
-            break  # no longer improving: round-off reached
-        if iterations >= _MAX_ITERATIONS:
+        # converged; no longer improving (round-off reached); or the cap
+        if (error < _CONVERGED or (iterations > 2 and error_last <= error)
+                or iterations >= _MAX_ITERATIONS):
             break
         error_last = error
         iterations += 1
@@ -528,6 +613,26 @@ def _iterate(t, dt, state, model, work, vdep, mask, a0, v0, x0, u0, b, csx, csv,
                     error = max_db / max_a
                 else:
                     error = math.inf
+    # end-of-step values, each term into the compensated sums, smallest first (a particle
+    # that does not move has every term 0, and its values are not used)
+    for c in range(m):
+        x = x0[c]
+        cx = csx[c]
+        v = u0[c]
+        cv = csv[c]
+        for j in range(6, -1, -1):
+            x, cx = _kahan(x, cx, b[j, c] / _XDIV[j] * dt * dt)
+            v, cv = _kahan(v, cv, b[j, c] / _VDIV[j] * dt)
+        x, cx = _kahan(x, cx, a0[c] / 2.0 * dt * dt)
+        x, cx = _kahan(x, cx, u0[c] * dt)
+        v, cv = _kahan(v, cv, a0[c] * dt)
+        nx[c] = x
+        ncx[c] = cx
+        nv[c] = v
+        ncv[c] = cv
+    for c in range(m):
+        if mask[c] != 0.0 and not (math.isfinite(nx[c]) and math.isfinite(nv[c])):
+            return c % n, iterations, evaluations
     return -1, iterations, evaluations
 
 
@@ -535,7 +640,7 @@ def _iterate(t, dt, state, model, work, vdep, mask, a0, v0, x0, u0, b, csx, csv,
 def _park(mask, n, a0, v0, vel, b, e, b_done, e_done, csx, csv):
     """Zero what moves a particle that must not move (pinned or inactive), so the loops can
     run over every component without a branch; v0 is the velocity of the moving ones
-    (flat arrays and ``mask`` per component, as in ``_iterate``)."""
+    (flat arrays and ``mask`` per component, as in ``_advance``)."""
     for k in range(vel.shape[0]):
         for i in range(n):
             c = k * n + i
@@ -552,7 +657,24 @@ def _park(mask, n, a0, v0, vel, b, e, b_done, e_done, csx, csv):
                     e_done[j, c] = 0.0
 
 
-@jit(error_model="numpy", inline="always")
+@jit(error_model="numpy", _nrt=False, fastmath={"contract"}, no_cpython_wrapper=True,
+     no_cfunc_wrapper=True)
+def _start(t, state, model, work, fused, mask, a0, v0, b, e, b_done, e_done, csx, csv):
+    """The start of a step: the accelerations a0 (``_forces``: compiled here on its own, the
+    force code at the nodes is inlined into ``_advance``) and, if every moving particle's is
+    finite, the particles that do not move parked (``_park``). Returns the first moving
+    particle with a non-finite acceleration, or -1."""
+    n = state.n
+    a02d = _matrix(a0, 0, state.pos.shape[0], n)
+    _forces(t, state, model, a02d, work, fused)
+    bad = _first_bad(a02d, mask, n)
+    if bad < 0:
+        _park(mask, n, a0, v0, state.vel, b, e, b_done, e_done, csx, csv)
+    return bad
+
+
+@jit(error_model="numpy", _nrt=False, fastmath={"contract"}, no_cpython_wrapper=True,
+     no_cfunc_wrapper=True)
 def _timescale2(a0, b, mask, n):
     """min over moving particles of tau_i^2 / dt^2 (Pham, Rein & Spiegel 2024), or inf
     (flat arrays, ``mask`` per component)."""
@@ -599,14 +721,19 @@ def _collapsed(h, t):
     return not (abs(h) > 8.0 * _EPS * abs(t) and abs(h) >= _MIN_NORMAL * 2.0 ** 52)
 
 
-@jit(error_model="numpy", inline="always")
-def _copy(source, target):
-    for j in range(source.shape[0]):
-        for c in range(source.shape[1]):
-            target[j, c] = source[j, c]
+@jit(error_model="numpy", _nrt=False, fastmath={"contract"}, no_cpython_wrapper=True,
+     no_cfunc_wrapper=True)
+def _keep(b, e, b_done, e_done, e_valid):
+    """b and e of the step just accepted into b_done and e_done; b for e when no prediction
+    was made for it (no correction to carry). One pass over the components."""
+    for c in range(b.shape[1]):
+        for j in range(7):
+            b_done[j, c] = b[j, c]
+            e_done[j, c] = e[j, c] if e_valid else b[j, c]
 
 
-@jit(error_model="numpy", inline="always")
+@jit(error_model="numpy", _nrt=False, fastmath={"contract"}, no_cpython_wrapper=True,
+     no_cfunc_wrapper=True)
 def _changed(pos, vel, x_end, v_end, n):
     for k in range(pos.shape[0]):
         for i in range(n):
@@ -615,7 +742,8 @@ def _changed(pos, vel, x_end, v_end, n):
     return False
 
 
-@jit(error_model="numpy", inline="always")
+@jit(error_model="numpy", _nrt=False, fastmath={"contract"}, no_cpython_wrapper=True,
+     no_cfunc_wrapper=True)
 def _store(memory, valid, dt_last, dt_pred, e_valid, t, tc, evaluations, rejected, capped,
           iterations, pos, vel, x_end, v_end, n):
     memory[MEMORY_VALID] = 1.0 if valid else 0.0
@@ -635,44 +763,43 @@ def _store(memory, valid, dt_last, dt_pred, e_valid, t, tc, evaluations, rejecte
 
 
 # -- the kernel -----------------------------------------------------------------------------------
-@jit(error_model="numpy")
+@jit(error_model="numpy", _nrt=False, fastmath={"contract"}, no_cfunc_wrapper=True)
 def advance(t, h, steps, state, model, work, vdep, t_end, tol, memory):
     """Up to ``steps`` accepted IAS15 steps from time ``t`` with first step ``h``.
 
     ``tol`` is IAS15's epsilon (> 0: adaptive steps; <= 0: every step is ``h``), ``memory``
     the caller's array of ``memory_shape(dim, n)`` (zeroed: cold start), updated in place.
     Returns ``(t, h_next, done, status)`` (``common``)."""
-    n = state.n
-    dim = state.pos.shape[0]
-    if memory.shape[0] != HEADER + _BLOCKS * dim * n:
-        raise ValueError("ias15: memory has the wrong size for this state (see memory_shape)")
-    moving = active_mask(state.active, state.pinned, n)
-    # every scratch array made here, once: the steps run in ``_advance``, compiled without
-    # reference counting (with it, each array taken out of a named tuple in the inlined loops
-    # paid atomic reference-count updates at every node). Per-component arrays are flat, the
-    # components in (k, i) order; ``mask`` is the moving flag per component.
-    m = dim * n
-    mask = np.empty(m)
-    for k in range(dim):
-        mask[k * n:(k + 1) * n] = moving
-    flat = np.empty((13, m))  # a0, acc, sx, sv, nx, nv, ncx, ncv, v0, x0, u0, w, change
-    g = np.empty((7, m))
-    csb = np.empty((7, m))
-    return _advance(t, h, steps, state, model, work, vdep, t_end, tol, memory, mask, flat[0],
-                    flat[1], flat[2], flat[3], flat[4], flat[5], flat[6], flat[7], flat[8],
-                    flat[9], flat[10], flat[11], flat[12], g, csb)
-
-
-@jit(error_model="numpy", _nrt=False, fastmath={"contract"})
-def _advance(t, h, steps, state, model, work, vdep, t_end, tol, memory, mask, a0, acc, sx, sv,
-             nx, nv, ncx, ncv, v0, x0, u0, w, change, g, csb):
-    """``advance``'s work, in the scratch it made."""
     pos = state.pos
     vel = state.vel
     n = state.n
     dim = pos.shape[0]
+    if memory.shape[0] != HEADER + _BLOCKS * dim * n:
+        raise ValueError("ias15: memory has the wrong size for this state (see memory_shape)")
+    # every scratch array, in one allocation freed at the one exit below (nothing in between
+    # raises). Per-component arrays are flat, the components in (k, i) order; ``mask`` is
+    # the moving flag per component.
     m = dim * n
-    a02d = a0.reshape((dim, n))
+    scratch = _scratch(28, m)
+    mask = scratch[0]
+    fill_active_mask(mask, state.active, state.pinned, n)
+    for c in range(n, m):
+        mask[c] = mask[c - n]
+    a0 = scratch[1]
+    acc = scratch[2]
+    sx = scratch[3]
+    sv = scratch[4]
+    nx = scratch[5]
+    nv = scratch[6]
+    ncx = scratch[7]
+    ncv = scratch[8]
+    v0 = scratch[9]
+    x0 = scratch[10]
+    u0 = scratch[11]
+    w = scratch[12]
+    change = scratch[13]
+    g = scratch[14:21]
+    csb = scratch[21:28]
     b, e, b_done, e_done, csx, csv, x_end, v_end = _views(memory, dim, n)
     fused = fused_gravity.applies(state, model)
 
@@ -684,7 +811,8 @@ def _advance(t, h, steps, state, model, work, vdep, t_end, tol, memory, mask, a0
         e_valid = memory[MEMORY_E_VALID] == 1.0
         tc = memory[MEMORY_T_COMPENSATION] if memory[MEMORY_T] == t else 0.0
     else:
-        memory[HEADER:] = 0.0
+        for x in range(HEADER, memory.shape[0]):
+            memory[x] = 0.0
         dt_last = 0.0
         dt_pred = 0.0
         e_valid = False
@@ -694,18 +822,22 @@ def _advance(t, h, steps, state, model, work, vdep, t_end, tol, memory, mask, a0
     growth = root7(tol * _FACTORIAL7) if adaptive else 1.0
     has_end = not math.isnan(t_end)
 
-
     evaluations = 0
     rejected = 0
     capped = 0
     iterations_total = 0
     done = 0
     need_a0 = True
-    if not (h != 0.0 and math.isfinite(h)):
-        _store(memory, warm, dt_last, dt_pred, e_valid, t, tc, 0, 0, 0, 0, pos, vel, x_end,
-              v_end, n)
-        return t, h, 0, STEP_COLLAPSED
-    while done < steps:
+    # one way out of the loop, its condition (``going``), and of the kernel, through
+    # ``_store``: each exit of a compiled loop repeats the clean-up of every variable that
+    # dies there. ``valid`` says whether the memory is left usable.
+    valid = True
+    status = OK
+    going = h != 0.0 and math.isfinite(h)
+    if not going:
+        valid = warm
+        status = STEP_COLLAPSED
+    while going and done < steps:
         dt = h
         last = False
         if has_end:
@@ -713,7 +845,8 @@ def _advance(t, h, steps, state, model, work, vdep, t_end, tol, memory, mask, a0
             if t == t_end or remaining == 0.0:
                 t = t_end
                 tc = 0.0
-                break
+                going = False
+                continue
             if (h > 0.0) != (remaining > 0.0):
                 h = -h  # towards t_end
                 dt = h
@@ -721,86 +854,59 @@ def _advance(t, h, steps, state, model, work, vdep, t_end, tol, memory, mask, a0
                 dt = remaining
                 last = True
         if not math.isfinite(t + dt):
-            _store(memory, False, dt_last, dt_pred, e_valid, t, tc, evaluations, rejected,
-                  capped, iterations_total, pos, vel, x_end, v_end, n)
-            return t, h, done, TIME_OVERFLOW
+            valid = False
+            status = TIME_OVERFLOW
+            going = False
+            continue
         # the predictor for this step length
         if dt != dt_pred:
             if dt_last != 0.0:
-                _predict(b_done, e_done, b, e, dt / dt_last, w)
+                _predict(b_done, e_done, b, e, dt / dt_last, False)
                 e_valid = True
             elif dt_pred != 0.0:
-                _rescale(b, dt / dt_pred)  # cold start: the rejected attempt's b, rescaled
+                # cold start: the rejected attempt's b, rescaled
+                _predict(b_done, e_done, b, e, dt / dt_pred, True)
             dt_pred = dt
         if need_a0:
-            _forces(t - tc, state, model, a02d, work, fused)
+            bad = _start(t - tc, state, model, work, fused, mask, a0, v0, b, e, b_done, e_done,
+                         csx, csv)
             evaluations += 1
-            bad = _first_bad(a02d, mask, n)
             if bad >= 0:  # nothing a shorter step can cure
-                _store(memory, False, dt_last, dt_pred, e_valid, t, tc, evaluations, rejected,
-                      capped, iterations_total, pos, vel, x_end, v_end, n)
-                return t, h, done, bad
-            _park(mask, n, a0, v0, vel, b, e, b_done, e_done, csx, csv)
+                valid = False
+                status = bad
+                going = False
+                continue
             need_a0 = False
 
-        status, iterations, count = _iterate(t - tc, dt, state, model, work, vdep, mask, a0, v0,
-                                             x0, u0, b, csx, csv, g, csb, acc, sx, sv, w, change,
-                                             fused)
+        attempt, iterations, count = _advance(t - tc, dt, state, model, work, vdep, fused, mask,
+                                              a0, v0, x0, u0, b, csx, csv, g, csb, acc, sx, sv,
+                                              w, change, nx, ncx, nv, ncv)
         evaluations += count
-        if status < 0:
-            # end-of-step values, each term into the compensated sums, smallest first (a
-            # particle that does not move has every term 0, and its values are not used)
-            for c in range(m):
-                nx[c] = x0[c]
-                ncx[c] = csx[c]
-                nv[c] = u0[c]
-                ncv[c] = csv[c]
-            for j in range(6, -1, -1):
-                fx = _XDIV[j]
-                fv = _VDIV[j]
-                for c in range(m):
-                    nx[c], ncx[c] = _kahan(nx[c], ncx[c], b[j, c] / fx * dt * dt)
-                    nv[c], ncv[c] = _kahan(nv[c], ncv[c], b[j, c] / fv * dt)
-            for c in range(m):
-                nx[c], ncx[c] = _kahan(nx[c], ncx[c], a0[c] / 2.0 * dt * dt)
-                nx[c], ncx[c] = _kahan(nx[c], ncx[c], u0[c] * dt)
-                nv[c], ncv[c] = _kahan(nv[c], ncv[c], a0[c] * dt)
-            for c in range(m):
-                if mask[c] != 0.0 and not (math.isfinite(nx[c]) and math.isfinite(nv[c])):
-                    status = c % n
-                    break
-        if status >= 0:
-            if not adaptive:
-                _store(memory, False, dt_last, dt_pred, e_valid, t, tc, evaluations, rejected,
-                      capped, iterations_total, pos, vel, x_end, v_end, n)
-                return t, h, done, status
+        if attempt >= 0 and not adaptive:
+            valid = False
+            status = attempt
+            going = False
+            continue
+        retry = OK  # or the status to return should the step retried collapse
+        if attempt >= 0:
             # a non-finite node or result: retry with a quarter of the step
-            rejected += 1
             h = dt * _SAFETY
             if dt_last == 0.0:
-                b[:] = 0.0  # nothing finite to rescale
+                for j in range(7):  # nothing finite to rescale
+                    for c in range(m):
+                        b[j, c] = 0.0
                 dt_pred = 0.0
-            if _collapsed(h, t):
-                _store(memory, False, dt_last, dt_pred, e_valid, t, tc, evaluations, rejected,
-                      capped, iterations_total, pos, vel, x_end, v_end, n)
-                return t, h, done, status
-            continue
-
-        if adaptive:
+            retry = attempt
+        elif adaptive:
             tau2 = _timescale2(a0, b, mask, n)
             if tau2 < math.inf:
                 dt_new = math.sqrt(tau2) * dt * growth
             else:
                 dt_new = dt / _SAFETY
             if abs(dt_new) < _SAFETY * abs(dt):
-                rejected += 1
                 h = dt_new
-                if _collapsed(h, t):
-                    _store(memory, False, dt_last, dt_pred, e_valid, t, tc, evaluations,
-                          rejected, capped, iterations_total, pos, vel, x_end, v_end, n)
-                    return t, h, done, STEP_COLLAPSED
-                continue
-            if last:
+                retry = STEP_COLLAPSED
+            elif last:
                 # the proposal before the step was shortened stands, unless a substantial
                 # landing step found a shorter timescale
                 if abs(dt) >= _SAFETY * abs(h) and abs(dt_new) < abs(h):
@@ -809,6 +915,13 @@ def _advance(t, h, steps, state, model, work, vdep, t_end, tol, memory, mask, a0
                 if abs(dt_new) > abs(dt) / _SAFETY:
                     dt_new = dt / _SAFETY
                 h = dt_new
+        if retry != OK:
+            rejected += 1
+            if _collapsed(h, t):
+                valid = False
+                status = retry
+                going = False
+            continue
         if iterations >= _MAX_ITERATIONS:
             capped += 1
         iterations_total += iterations
@@ -835,19 +948,15 @@ def _advance(t, h, steps, state, model, work, vdep, t_end, tol, memory, mask, a0
             tc = 0.0
         else:
             t, tc = _kahan(t, tc, dt)
-        _copy(b, b_done)
-        if e_valid:
-            _copy(e, e_done)
-        else:
-            _copy(b, e_done)  # no prediction was made for this step: no correction to carry
+        _keep(b, e, b_done, e_done, e_valid)
         dt_last = dt
-        _predict(b_done, e_done, b, e, h / dt, w)
+        _predict(b_done, e_done, b, e, h / dt, False)
         e_valid = True
         dt_pred = h
         need_a0 = True
         done += 1
-        if last:
-            break
-    _store(memory, True, dt_last, dt_pred, e_valid, t, tc, evaluations, rejected, capped,
-          iterations_total, pos, vel, x_end, v_end, n)
-    return t, h, done, OK
+        going = not last
+    _store(memory, valid, dt_last, dt_pred, e_valid, t, tc, evaluations, rejected, capped,
+           iterations_total, pos, vel, x_end, v_end, n)
+    _release(scratch)
+    return t, h, done, status

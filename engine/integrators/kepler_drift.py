@@ -28,9 +28,14 @@ If the iteration has not met round-off after ``MAX_ITERATIONS``, the drift is ta
 ``drift_columns`` moves all of a step's bodies at once, their iterations in lockstep (see
 there).
 """
+import functools
 import math
 
 import numpy as np
+from numba import types
+from numba.extending import intrinsic
+
+from ..address_calls import call_at, check_call, entry_address
 from ..cache import jit
 
 from ..analytic import kepler_step
@@ -121,11 +126,12 @@ def _start_of_x(dt, r0, eta0, v2, beta, mu):
     return dt * inv, dt
 
 
-@jit(error_model="numpy", inline="always")
+@jit(error_model="numpy", _nrt=False, fastmath=False)
 def drift_column(jp, jv, j, mu, dt, r, v):
     """Column ``j`` of positions ``jp`` and velocities ``jv`` (dim, count) moved along its
     Kepler orbit about mu for time dt, in place. ``r``, ``v`` are dim-long scratch for the
-    fallback."""
+    fallback. ``drift_columns``' fallback for a column its lockstep solve left: called, not
+    inlined, so that this rare path stays out of the lockstep code."""
     dim = jp.shape[0]
     x, y, z, vx, vy, vz, r0, v2, eta0 = _column(jp, jv, j)
     beta = 2.0 * mu / r0 - v2
@@ -301,14 +307,6 @@ def _apply_all(jp, jv, kw, first, count):
             jv[k, j] = fd * x + gd * v if ok else v
 
 
-@jit(error_model="numpy", _nrt=False, fastmath=False)
-def _drift_column_call(jp, jv, j, mu, dt, kw):
-    """``drift_column`` called, not inlined: the rare path kept out of the lockstep code."""
-    dim = jp.shape[0]
-    drift_column(jp, jv, j, mu, dt, kw[_RV_R, :dim], kw[_RV_V, :dim])
-
-
-@jit(error_model="numpy", _nrt=False, fastmath={"contract"})
 def drift_columns(jp, jv, first, count, mu, dt, kw, known=False):
     """Columns ``first`` to ``count`` of ``jp``, ``jv`` (dim, count) moved along their Kepler
     orbits about ``mu[j]`` for time dt, in place (mu[j] = 0: a straight line): the same
@@ -319,7 +317,56 @@ def drift_columns(jp, jv, first, count, mu, dt, kw, known=False):
     ``known``: rows ``R0_ROW`` and ``INV_R0_ROW`` of ``kw`` already hold |r| and 1 / |r| of
     these very positions (the interaction that came just before computed them for its Kepler
     terms), so the drift takes them from there: a square root and a division less a column,
-    on the chain every step waits for (outer solar system: 270 -> 258 ns a step)."""
+    on the chain every step waits for (outer solar system: 270 -> 258 ns a step).
+
+    For Python callers (the tests): ``drift_columns_at``, which the integrators call, with the
+    fallback's address, the very code the integrators run."""
+    if known:
+        drift_columns_at(jp, jv, first, count, mu, dt, kw, fallback_address(), True)
+    else:  # omitted: the integrators' own compiled version
+        drift_columns_at(jp, jv, first, count, mu, dt, kw, fallback_address())
+
+
+# -- the fallback called through its address ------------------------------------------------------
+# A compiled function carries the machine code of every compiled function it calls (numba links
+# the callee into the caller, and optimises and translates the whole again for each caller up
+# the chain): the fallback's ``engine.analytic.kepler_step`` is large, and was compiled again in
+# each of the half-dozen Wisdom-Holman functions above a drift. Called through its address
+# (``fallback_address``, made in Python and passed down as an int64), it is compiled once.
+
+
+_F8_1D = types.Array(types.float64, 1, "C")
+_F8_2D = types.Array(types.float64, 2, "C")
+#: the types ``drift_column`` is compiled for when called through its address
+FALLBACK_ARGUMENTS = (_F8_2D, _F8_2D, types.int64, types.float64, types.float64, _F8_1D, _F8_1D)
+
+
+@functools.lru_cache(maxsize=None)
+def fallback_address():
+    """The address of the fallback (``drift_column``) for ``drift_columns_at``: compiled on the
+    first call in a process, or loaded from the compiled-code cache."""
+    return entry_address(drift_column, types.none(*FALLBACK_ARGUMENTS))
+
+
+@intrinsic
+def _call_drift_column(typingctx, address, jp, jv, j, mu, dt, r, v):
+    """``drift_column(jp, jv, j, mu, dt, r, v)`` through its address."""
+    given = (jp, jv, j, mu, dt, r, v)
+    check_call(given, FALLBACK_ARGUMENTS, "the drift's fallback")
+
+    def codegen(context, builder, signature, args):
+        call_at(context, builder, args[0], types.none, FALLBACK_ARGUMENTS, given, args[1:])
+        return context.get_dummy_value()
+    return types.none(address, *given), codegen
+
+
+@jit(error_model="numpy", _nrt=False, fastmath={"contract"}, no_cfunc_wrapper=True)
+def drift_columns_at(jp, jv, first, count, mu, dt, kw, fallback, known=False):
+    """``drift_columns`` with its fallback called through ``fallback`` (``fallback_address()``),
+    so that the fallback's code is compiled once, not in every caller. The integrators
+    compile it with ``known`` a constant, False or True (numba's ``Omitted`` argument): its
+    test taken out of each column's start, 0.2-2% of a step (a lone orbit to three planets
+    with SABA, measured in one process against ``known`` passed at run time)."""
     dim = jp.shape[0]
     kepler = 0
     for j in range(first, count):
@@ -336,4 +383,5 @@ def drift_columns(jp, jv, first, count, mu, dt, kw, known=False):
         _apply_all(jp, jv, kw, first, count)
         for j in range(first, count):
             if mu[j] > 0.0 and kw[_OK, j] != 2.0:
-                _drift_column_call(jp, jv, j, mu[j], dt, kw)
+                _call_drift_column(fallback, jp, jv, j, mu[j], dt, kw[_RV_R, :dim],
+                                   kw[_RV_V, :dim])

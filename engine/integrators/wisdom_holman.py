@@ -46,6 +46,10 @@ import functools
 import math
 
 import numpy as np
+from numba import types
+from numba.core import cgutils
+from numba.extending import intrinsic
+
 from ..cache import jit
 
 from ..forces.dispatch import EMPTY_MODEL, accelerations_inline
@@ -54,7 +58,9 @@ from ..forces.point_mass import PointMass
 from ..space import wrap_scalar
 from . import direct as _direct
 from .common import OK, all_finite
-from .kepler_drift import INV_R0_ROW, R0_ROW, SCRATCH_ROWS, drift_columns
+from ..address_calls import call_at, check_call, entry_address
+from .kepler_drift import (INV_R0_ROW, R0_ROW, SCRATCH_ROWS, drift_columns_at,
+                           fallback_address)
 
 NAME = "whfast"
 ORDER = 2
@@ -118,6 +124,12 @@ def corrector_table(order):
     rows = [[-(m - k) * _A1, -bs[k]] for k in range(m)]
     rows += [[(m - k) * _A1, bs[k]] for k in reversed(range(m))]
     return np.array(rows)
+
+
+#: the options of the compiled functions only compiled code calls (directly or through their
+#: addresses): no wrappers for calls from Python or C, which numba would otherwise build and
+#: compile with each (unboxing a ``State`` and a ``Model`` is more code than a drift)
+_CALLED = {"no_cpython_wrapper": True, "no_cfunc_wrapper": True}
 
 
 # -- coordinates ------------------------------------------------------------------------------
@@ -255,7 +267,7 @@ def _jump(jp, jv, mo, count, massive, m0, h):
             jp[k, j] += shift
 
 
-@jit(error_model="numpy", _nrt=False)
+@jit(error_model="numpy", _nrt=False, **_CALLED)
 def _democratic_interaction(t, jp, jv, state, kick_model, work, m, order, count, eta, mu, center,
                             acc, ja, kick_com, mo, massive, G, with_vel):
     """The interaction acceleration in democratic heliocentric coordinates: with gravity the
@@ -314,11 +326,142 @@ def _democratic_interaction(t, jp, jv, state, kick_model, work, m, order, count,
             ja[k, j] = acc[k, i] + f * jp[k, j] - ja[k, 0]
 
 
-@jit(error_model="numpy", _nrt=False)
-def _democratic_kick(t, h, jp, jv, state, kick_model, work, m, order, count, eta, mu, center,
-                     acc, ja, kick_com, shifted, vdep, mo, massive, G):
-    """jump(h/2) interaction(h) jump(h/2); velocity-dependent terms at the midpoint velocity,
-    as in the other modes."""
+# -- calls through addresses ----------------------------------------------------------------------
+# A compiled function carries the machine code of every compiled function it calls: numba links
+# the callee in, and optimises and translates the whole again for each caller up the chain. The
+# step loop, the kicks of each kind of scene, SABA's corrector and the fast loops are therefore
+# called through their addresses, chosen in Python for the scene and the scheme (``_addresses``,
+# part of ``Plan.kernel_tail``) and passed down in an int64 array: each is compiled once, and
+# only when a scene needs it (``python -m engine``'s lone orbit compiles no kick at all; whfast on
+# planets none of the general force table). Each slot takes one fixed signature
+# (``_slot_types``); the scratch travels as the arrays it is cut from (``columns``, ``rows``),
+# so that a call passes few arguments.
+
+#: the slots of the ``addresses`` array: the step loop (``_steps``, in the version for the
+#: scene), the fast loop of the common case (0: none), the kick (0: JACOBI_GRAVITY's own,
+#: compiled in, or nothing to kick), SABA's corrector (0: none), the Kepler drift
+#: (``kepler_drift.drift_columns_at``), the same with |r| known (``_gravity_steps``' drift,
+#: 0: no such loop) and the drift's fallback
+STEPS, LOOP, KICK, LAZY, DRIFT, DRIFT_KNOWN, FALLBACK = range(7)
+_SLOT_NAMES = ("the step loop", "the fast loop", "the kick", "the lazy corrector",
+               "the drift", "the drift", "the drift's fallback")
+
+
+@functools.lru_cache(maxsize=None)
+def _slot_types():
+    """``(return type, argument types)`` of each slot's functions: the engine's named tuples
+    as the force kernels take them (``engine.forces.calls.argument_types``), C-contiguous
+    arrays, int64 and float64 numbers."""
+    from numba import typeof
+
+    from ..forces.calls import argument_types
+
+    accumulate = argument_types()[0]
+    state, work = accumulate[1], accumulate[9]
+    model = typeof(EMPTY_MODEL)
+    f8, i8, b1 = types.float64, types.int64, types.boolean
+    f1, f2, f3 = (types.Array(f8, d, "C") for d in (1, 2, 3))
+    i1, bools = types.Array(i8, 1, "C"), types.Array(b1, 1, "C")
+    steps = (f8, f8, i8, state, model, work, b1, i8, i1, f1, f8, f8, f1, bools, b1, i8, f2, f1,
+             f1, f8, i1, f3, f2, f2, f2, f2, f2)
+    loop = (f8, f8, i8, f3, f2, f2, i8, i8, f8, f1, f1, b1, f8, i1)
+    kick = (f8, f8, state, model, work, i8, f1, i1, i8, f1, f3, f2, f2, f2, b1, i8, b1, i8, f8)
+    lazy = (f8, f8, f8, state, model, work, i8, f1, i1, i8, f1, f3, f2, f2, b1, b1)
+    drift = (f2, f2, i8, i8, f1, f8, f2, i8)
+    return {STEPS: (types.Tuple((f8, f8, i8, i8)), steps),
+            LOOP: (types.Tuple((f8, i8, i8)), loop),
+            KICK: (types.none, kick),
+            LAZY: (types.none, lazy),
+            DRIFT: (types.none, drift)}
+
+
+def _slot_signature(slot, address, args):
+    """The typing of a call of ``slot`` through ``address`` with the tuple ``args``."""
+    restype, wanted = _slot_types()[slot]
+    given = tuple(args)
+    check_call(given, wanted, _SLOT_NAMES[slot])
+
+    def codegen(context, builder, signature, values):
+        parts = cgutils.unpack_tuple(builder, values[1], len(given))
+        value = call_at(context, builder, values[0], restype, wanted, given, parts)
+        return context.get_dummy_value() if restype == types.none else value
+    return restype(address, args), codegen
+
+
+@intrinsic
+def _call_steps(typingctx, address, args):
+    """``_steps(*args)`` through its address."""
+    return _slot_signature(STEPS, address, args)
+
+
+@intrinsic
+def _call_loop(typingctx, address, args):
+    """``_gravity_steps(*args)`` or ``_free_steps(*args)`` through its address."""
+    return _slot_signature(LOOP, address, args)
+
+
+@intrinsic
+def _call_kick(typingctx, address, args):
+    """The scene's kick (``_democratic_kick``, ``_kick``) through its address."""
+    return _slot_signature(KICK, address, args)
+
+
+@intrinsic
+def _call_lazy(typingctx, address, args):
+    """``_lazy_corrector(*args)`` through its address."""
+    return _slot_signature(LAZY, address, args)
+
+
+@intrinsic
+def _call_drift(typingctx, address, args):
+    """``drift_columns_at(*args)`` through its address."""
+    return _slot_signature(DRIFT, address, args)
+
+
+@functools.lru_cache(maxsize=None)
+def _slot_address(slot, function, *defaults):
+    """The address of ``function`` compiled for ``slot``'s signature (compiled on the first
+    call in a process, or loaded from the compiled-code cache); ``defaults``: the values of
+    its further parameters, compiled in as constants (numba's ``Omitted`` arguments, which
+    take no part in a call: the slot's callers pass the slot's arguments alone). numba takes
+    True and 1, False and 0, for the same constant (whichever it met first): the code only
+    tests these for truth, or against None."""
+    restype, wanted = _slot_types()[slot]
+    return entry_address(function, restype(*wanted, *map(types.Omitted, defaults)))
+
+
+@functools.lru_cache(maxsize=None)
+def _addresses(free, mode, kernel, one_stage, lazy):
+    """The ``addresses`` array of a scene and scheme: ``free`` nothing to kick (ATTRACTOR mode,
+    the attractor the only term), ``mode``, the ``kernel`` code, ``one_stage`` one kick a
+    step, ``lazy`` SABA's corrector. Made once per combination in a process (each function
+    compiled, or loaded from the cache, when first needed); shared, read only."""
+    loop = known = 0  # the common cases' own loops (see ``_gravity_steps``)
+    if free:
+        loop = _slot_address(LOOP, _free_steps)
+    elif one_stage and not lazy and mode == JACOBI_GRAVITY and kernel == KERNEL_STANDARD:
+        loop = _slot_address(LOOP, _gravity_steps)
+        known = _slot_address(DRIFT, drift_columns_at, True)
+    kick = 0
+    if not free and mode != JACOBI_GRAVITY:
+        kick = _slot_address(KICK, _democratic_kick if mode == DEMOCRATIC else _kick)
+    corrector = _slot_address(LAZY, _lazy_corrector) if lazy and not free else 0
+    # ``_steps``' version for the scene (see there)
+    steps = _slot_address(STEPS, _steps, None if free else True)
+    return np.array([steps, loop, kick, corrector,
+                     _slot_address(DRIFT, drift_columns_at, False), known, fallback_address()],
+                    dtype=np.int64)
+
+
+# -- the two operators ------------------------------------------------------------------------
+@jit(error_model="numpy", _nrt=False, **_CALLED)
+def _democratic_kick(t, h, state, kick_model, work, mode, m, order, count, center, columns,
+                     rows, acc, kw, kick_com, kernel, vdep, massive, G):
+    """DEMOCRATIC mode's kick (slot ``KICK``): jump(h/2) interaction(h) jump(h/2);
+    velocity-dependent terms at the midpoint velocity, as in the other modes."""
+    jp, jv, shifted, ja = columns[0], columns[1], columns[4], columns[5]
+    eta, mu = rows[0], rows[1]
+    mo = rows[2:]
     dim = jp.shape[0]
     m0 = mo[0, 0]
     _jump(jp, jv, mo, count, massive, m0, 0.5 * h)
@@ -336,27 +479,33 @@ def _democratic_kick(t, h, jp, jv, state, kick_model, work, m, order, count, eta
     _jump(jp, jv, mo, count, massive, m0, 0.5 * h)
 
 
-# -- the two operators ------------------------------------------------------------------------
 @jit(error_model="numpy", inline="always")
-def _kepler_drift(mode, jp, jv, mu, count, h, kw, box):
+def _kepler_drift(mode, jp, jv, mu, count, h, kw, box, addresses):
     """Every moving body along its Kepler orbit for time h (mu[j] = 0: a straight line;
-    ``kepler_drift.drift_columns``, ``kw`` its scratch); in JACOBI mode column 0, the centre
-    of mass, always moves in a straight line. In a periodic space (ATTRACTOR mode only) each
-    position relative to the attractor is taken back to its nearest image afterwards, the
-    image the attractor's force acts from."""
+    ``kepler_drift.drift_columns_at`` at ``addresses[DRIFT]``, ``kw`` its scratch); in JACOBI
+    mode column 0, the centre of mass, always moves in a straight line. In a periodic space
+    (ATTRACTOR mode only) each position relative to the attractor is taken back to its nearest
+    image afterwards, the image the attractor's force acts from."""
     dim = jp.shape[0]
     first = 1 if mode != ATTRACTOR else 0
     if mode != ATTRACTOR:
         for k in range(dim):
             jp[k, 0] += h * jv[k, 0]
-    drift_columns(jp, jv, first, count, mu, h, kw, False)  # one specialisation for both calls
+    _call_drift(addresses[DRIFT], (jp, jv, first, count, mu, h, kw, addresses[FALLBACK]))
     if box > 0.0:
-        for j in range(first, count):
-            for k in range(dim):
-                jp[k, j] = wrap_scalar(jp[k, j], box)
+        _wrap_columns(jp, first, count, box)
 
 
-@jit(error_model="numpy", _nrt=False)  # one copy of the inlined force table
+@jit(error_model="numpy", _nrt=False, **_CALLED)
+def _wrap_columns(jp, first, count, box):
+    """Columns ``first`` to ``count`` of ``jp`` to their nearest images in a periodic space of
+    side ``box`` (called, not inlined into each drift: only a periodic scene takes it)."""
+    for j in range(first, count):
+        for k in range(jp.shape[0]):
+            jp[k, j] = wrap_scalar(jp[k, j], box)
+
+
+@jit(error_model="numpy", _nrt=False, **_CALLED)  # one copy of the inlined force table
 def _interaction(mode, t, jp, state, kick_model, work, m, order, count, eta, mu, center, acc,
                  ja, kick_com):
     """The acceleration of the interaction part at the current positions, per coordinate
@@ -385,7 +534,7 @@ def _interaction(mode, t, jp, state, kick_model, work, m, order, count, eta, mu,
                 ja[k, j] += s * jp[k, j]
 
 
-@jit(error_model="numpy", _nrt=False, fastmath={"contract"})
+@jit(error_model="numpy", _nrt=False, fastmath={"contract"}, **_CALLED)
 def _gravity_interaction(jp, mo, count, massive, eta, mu, G, xs, ad, ja, kw):
     """JACOBI_GRAVITY mode's interaction acceleration (``_interaction``'s, for mutual
     gravity alone), on the coordinates' own columns: the inertial positions from the Jacobi
@@ -486,52 +635,86 @@ def _gravity_interaction(jp, mo, count, massive, eta, mu, G, xs, ad, ja, kw):
 
 
 @jit(error_model="numpy", inline="always")
+def _from_attractor(jp, jv, order, count, center, pos, vel, with_vel, box):
+    """ATTRACTOR mode's inertial positions (and velocities): the attractor's position added,
+    in a periodic space the nearest image taken."""
+    for j in range(count):
+        i = order[j]
+        for k in range(jp.shape[0]):
+            pos[k, i] = wrap_scalar(jp[k, j] + center[k], box)
+            if with_vel:
+                vel[k, i] = jv[k, j]
+
+
+@jit(error_model="numpy", _nrt=False, **_CALLED)
 def _sync_positions(mode, jp, jv, m, order, count, eta, center, pos, vel, with_vel, box):
     """Inertial positions (and velocities) in ``pos``, ``vel`` from the coordinates."""
-    dim = jp.shape[0]
     if mode == DEMOCRATIC:
         _from_democratic(jp, jv, m, order, count, eta, pos, vel, with_vel)
         return
     if mode != ATTRACTOR:
         _from_jacobi(jp, jv, m, order, count, eta, pos, vel, with_vel)
         return
+    _from_attractor(jp, jv, order, count, center, pos, vel, with_vel, box)
+
+
+@jit(error_model="numpy", inline="always")
+def _sync_kicked(mode, jp, jv, m, order, count, eta, center, pos, vel, with_vel, box):
+    """``_sync_positions`` for the modes ``_kick`` and ``_lazy_corrector`` take (ATTRACTOR,
+    JACOBI, JACOBI_GRAVITY), inlined: a call to it in each kick cost 10 ns, measured (3% of a
+    step of two particles with drag about a star)."""
+    if mode != ATTRACTOR:
+        _from_jacobi(jp, jv, m, order, count, eta, pos, vel, with_vel)
+    else:
+        _from_attractor(jp, jv, order, count, center, pos, vel, with_vel, box)
+
+
+@jit(error_model="numpy", inline="always")
+def _sync(kicking, mode, jp, jv, m, order, count, eta, center, pos, vel, with_vel, box):
+    """``_sync_positions``; ``kicking`` None (see ``_steps``): ATTRACTOR mode's alone."""
+    if kicking is not None:
+        _sync_positions(mode, jp, jv, m, order, count, eta, center, pos, vel, with_vel, box)
+    else:
+        _from_attractor(jp, jv, order, count, center, pos, vel, with_vel, box)
+
+
+@jit(error_model="numpy", inline="always")
+def _gravity_kick(h, kernel, count, massive, G, columns, rows, kw):
+    """JACOBI_GRAVITY mode's kick: v' += h a'_interaction, a' by ``_gravity_interaction``;
+    the lazy kernel evaluates a' at positions moved by h^2/12 a' first. Inlined into the
+    step loop (a kick in a function of its own, called, cost 19 ns more, measured: 4% of a
+    SABA step of three planets)."""
+    jp, jv, shifted, ja = columns[0], columns[1], columns[4], columns[5]
+    xs, ad = columns[7], columns[8]
+    eta, mu = rows[0], rows[1]
+    mo = rows[2:]
+    dim = jp.shape[0]
+    _gravity_interaction(jp, mo, count, massive, eta, mu, G, xs, ad, ja, kw)
+    if kernel == KERNEL_LAZY:
+        eps = h * h / 12.0
+        for j in range(count):
+            for k in range(dim):
+                shifted[k, j] = jp[k, j] + (eps * ja[k, j] if j >= 1 else 0.0)
+        _gravity_interaction(shifted, mo, count, massive, eta, mu, G, xs, ad, ja, kw)
     for j in range(count):
-        i = order[j]
         for k in range(dim):
-            pos[k, i] = wrap_scalar(jp[k, j] + center[k], box)
-            if with_vel:
-                vel[k, i] = jv[k, j]
+            jv[k, j] += h * ja[k, j]
 
 
-@jit(error_model="numpy", _nrt=False)
-def _kick(mode, t, h, jp, jv, state, kick_model, work, m, order, count, eta, mu, center, acc,
-          ja, kick_com, kernel, shifted, vdep, mo, xs, ad, massive, G, kw):
-    """v' += h a'_interaction; the lazy kernel evaluates a' at positions moved by
+@jit(error_model="numpy", _nrt=False, **_CALLED)
+def _kick(t, h, state, kick_model, work, mode, m, order, count, center, columns, rows, acc, kw,
+          kick_com, kernel, vdep, massive, G):
+    """The kick of ATTRACTOR mode (with terms besides the attractor) and JACOBI mode (slot
+    ``KICK``): v' += h a'_interaction; the lazy kernel evaluates a' at positions moved by
     h^2/12 a' first. With velocity-dependent terms the acceleration is taken at the
     velocities half way through the kick (explicit midpoint; the lazy kernel then does not
     apply)."""
+    jp, jv, shifted, ja = columns[0], columns[1], columns[4], columns[5]
+    eta, mu = rows[0], rows[1]
     dim = jp.shape[0]
     pos = state.pos
     vel = state.vel
-    if mode == JACOBI_GRAVITY:
-        _gravity_interaction(jp, mo, count, massive, eta, mu, G, xs, ad, ja, kw)
-        if kernel == KERNEL_LAZY:
-            eps = h * h / 12.0
-            for j in range(count):
-                for k in range(dim):
-                    shifted[k, j] = jp[k, j] + (eps * ja[k, j] if j >= 1 else 0.0)
-            _gravity_interaction(shifted, mo, count, massive, eta, mu, G, xs, ad, ja, kw)
-        for j in range(count):
-            for k in range(dim):
-                jv[k, j] += h * ja[k, j]
-        return
-    if mode == DEMOCRATIC:
-        _democratic_kick(t, h, jp, jv, state, kick_model, work, m, order, count, eta, mu, center,
-                         acc, ja, kick_com, shifted, vdep, mo, massive, G)
-        return
-    if mode == ATTRACTOR and kick_model.kinds.shape[0] == 0:
-        return  # the attractor is the only term: nothing to kick (test particles, a lone orbit)
-    _sync_positions(mode, jp, jv, m, order, count, eta, center, pos, vel, vdep, state.box)
+    _sync_kicked(mode, jp, jv, m, order, count, eta, center, pos, vel, vdep, state.box)
     _interaction(mode, t, jp, state, kick_model, work, m, order, count, eta, mu, center, acc,
                  ja, kick_com)
     if vdep:
@@ -540,8 +723,7 @@ def _kick(mode, t, h, jp, jv, state, kick_model, work, m, order, count, eta, mu,
         for j in range(count):
             for k in range(dim):
                 shifted[k, j] = jv[k, j] + 0.5 * h * ja[k, j]
-        _sync_positions(mode, jp, shifted, m, order, count, eta, center, pos, vel, True,
-                        state.box)
+        _sync_kicked(mode, jp, shifted, m, order, count, eta, center, pos, vel, True, state.box)
         _interaction(mode, t, jp, state, kick_model, work, m, order, count, eta, mu, center,
                      acc, ja, kick_com)
     elif kernel == KERNEL_LAZY:
@@ -550,8 +732,8 @@ def _kick(mode, t, h, jp, jv, state, kick_model, work, m, order, count, eta, mu,
         for j in range(count):
             for k in range(dim):
                 shifted[k, j] = jp[k, j] + (eps * ja[k, j] if j >= first else 0.0)
-        _sync_positions(mode, shifted, jv, m, order, count, eta, center, pos, vel, False,
-                        state.box)
+        _sync_kicked(mode, shifted, jv, m, order, count, eta, center, pos, vel, False,
+                     state.box)
         _interaction(mode, t, shifted, state, kick_model, work, m, order, count, eta, mu,
                      center, acc, ja, kick_com)
     for j in range(count):
@@ -560,45 +742,36 @@ def _kick(mode, t, h, jp, jv, state, kick_model, work, m, order, count, eta, mu,
 
 
 @jit(error_model="numpy", inline="always")
-def _kick_step(mode, t, h, jp, jv, state, kick_model, work, m, order, count, eta, mu, center,
-               acc, ja, kick_com, kernel, shifted, vdep, mo, xs, ad, massive, G, kw):
-    """``_kick``, with its two common cases taken without calling it: nothing to kick
-    (ATTRACTOR mode, the attractor the only term) and mutual gravity alone with the standard
-    kernel (``_gravity_interaction``, then v' += h a'). A call passes each of its arrays as
-    its parts (pointers, shape, strides): ``_kick``'s two dozen arguments cost about as much
-    as a small system's Kepler drift, measured, so the step loop calls it only for the rest."""
-    if mode == ATTRACTOR and kick_model.kinds.shape[0] == 0:
-        return
-    if mode == JACOBI_GRAVITY and kernel == KERNEL_STANDARD:
-        _gravity_interaction(jp, mo, count, massive, eta, mu, G, xs, ad, ja, kw)
-        dim = jp.shape[0]
-        for j in range(count):
-            for k in range(dim):
-                jv[k, j] += h * ja[k, j]
-        return
-    _kick(mode, t, h, jp, jv, state, kick_model, work, m, order, count, eta, mu, center, acc, ja,
-          kick_com, kernel, shifted, vdep, mo, xs, ad, massive, G, kw)
+def _kick_at(addresses, t, h, state, kick_model, work, mode, m, order, count, center, columns,
+             rows, acc, kw, kick_com, kernel, vdep, massive, G):
+    """The scene's kick: the one at ``addresses[KICK]``, or (0) JACOBI_GRAVITY's, compiled
+    in."""
+    if addresses[KICK] == 0:
+        _gravity_kick(h, kernel, count, massive, G, columns, rows, kw)
+    else:
+        _call_kick(addresses[KICK], (t, h, state, kick_model, work, mode, m, order, count, center,
+                                     columns, rows, acc, kw, kick_com, kernel, vdep, massive, G))
 
 
-@jit(error_model="numpy", _nrt=False)
-def _corrector(table, sign, h, mode, t, jp, jv, state, kick_model, work, m, order, count, eta,
-               mu, center, acc, ja, kick_com, kw, shifted, vdep, mo, xs, ad, massive, G):
+@jit(error_model="numpy", _nrt=False, **_CALLED)
+def _corrector(table, sign, h, t, state, kick_model, work, mode, m, order, count, center,
+               columns, rows, acc, kw, kick_com, vdep, massive, G, addresses):
     """The corrector (sign 1) or its inverse (sign -1): Z(a, b) = D(a) K(-b) D(-2a) K(b) D(a)
-    for each row (a / h, b / h) of ``table``."""
-    if mode == ATTRACTOR and kick_model.kinds.shape[0] == 0:
-        return  # no interaction: every kick is zero, and each Z(a, b) the identity
+    for each row (a / h, b / h) of ``table``; the kicks with the standard kernel. A scene
+    with nothing to kick has none (each Z(a, b) would be the identity): ``_steps`` does not
+    call it then."""
+    jp, jv = columns[0], columns[1]
+    mu = rows[1]
     for row in range(table.shape[0]):
         a = table[row, 0] * h
         b = sign * table[row, 1] * h
-        _kepler_drift(mode, jp, jv, mu, count, a, kw, state.box)
-        _kick_step(mode, t, -b, jp, jv, state, kick_model, work, m, order, count, eta, mu,
-                   center, acc, ja, kick_com, KERNEL_STANDARD, shifted, vdep, mo, xs, ad,
-                   massive, G, kw)
-        _kepler_drift(mode, jp, jv, mu, count, -2.0 * a, kw, state.box)
-        _kick_step(mode, t, b, jp, jv, state, kick_model, work, m, order, count, eta, mu,
-                   center, acc, ja, kick_com, KERNEL_STANDARD, shifted, vdep, mo, xs, ad,
-                   massive, G, kw)
-        _kepler_drift(mode, jp, jv, mu, count, a, kw, state.box)
+        _kepler_drift(mode, jp, jv, mu, count, a, kw, state.box, addresses)
+        _kick_at(addresses, t, -b, state, kick_model, work, mode, m, order, count, center,
+                 columns, rows, acc, kw, kick_com, KERNEL_STANDARD, vdep, massive, G)
+        _kepler_drift(mode, jp, jv, mu, count, -2.0 * a, kw, state.box, addresses)
+        _kick_at(addresses, t, b, state, kick_model, work, mode, m, order, count, center,
+                 columns, rows, acc, kw, kick_com, KERNEL_STANDARD, vdep, massive, G)
+        _kepler_drift(mode, jp, jv, mu, count, a, kw, state.box, addresses)
 
 
 @jit(error_model="numpy", inline="always")
@@ -611,14 +784,17 @@ def _first_bad_column(jp, jv, count):
 
 
 @jit(error_model="numpy", inline="always")
-def _coordinates(mode, pos, vel, m, order, count, center, jp, jv, eta, box):
+def _coordinates(kicking, mode, pos, vel, m, order, count, center, jp, jv, eta, box):
+    """The coordinates of the inertial state; ``kicking`` None (see ``_steps``): ATTRACTOR
+    mode's, relative to the attractor, alone."""
     dim = pos.shape[0]
-    if mode == DEMOCRATIC:
-        _to_democratic(pos, vel, m, order, count, jp, jv, eta)
-        return
-    if mode != ATTRACTOR:
-        _to_jacobi(pos, vel, m, order, count, jp, jv, eta)
-        return
+    if kicking is not None:
+        if mode == DEMOCRATIC:
+            _to_democratic(pos, vel, m, order, count, jp, jv, eta)
+            return
+        if mode != ATTRACTOR:
+            _to_jacobi(pos, vel, m, order, count, jp, jv, eta)
+            return
     for j in range(count):
         i = order[j]
         for k in range(dim):
@@ -639,18 +815,19 @@ def kepler_parameters(mode, m, order, count, eta, G, mu_attractor, attracted, mu
             mu[j] = mu_attractor if attracted[order[j]] else 0.0
 
 
-@jit(error_model="numpy", _nrt=False)
-def _lazy_corrector(cc, h, mode, t, jp, jv, state, kick_model, work, m, order, count, eta, mu,
-                    center, acc, ja, kick_com, shifted, ja0, vdep):
+@jit(error_model="numpy", _nrt=False, **_CALLED)
+def _lazy_corrector(cc, h, t, state, kick_model, work, mode, m, order, count, center, columns,
+                    rows, acc, kick_com, vdep):
     """SABA's corrector exp(cc h^3 L_{{A,B},B}) by the lazy implementer's difference
     (Wisdom, Holman & Touma 1996, eq. 10.6; Rein, Tamayo & Brown 2019, sec. 2.3):
-    v' += 12 cc h (a'(r' + h^2/12 a') - a'(r')), the positions left where they were."""
-    if mode == ATTRACTOR and kick_model.kinds.shape[0] == 0:
-        return  # no interaction: its corrector is zero
+    v' += 12 cc h (a'(r' + h^2/12 a') - a'(r')), the positions left where they were (slot
+    ``LAZY``; a scene with no interaction has none: zero)."""
+    jp, jv, shifted, ja, ja0 = columns[0], columns[1], columns[4], columns[5], columns[6]
+    eta, mu = rows[0], rows[1]
     dim = jp.shape[0]
     pos = state.pos
     vel = state.vel
-    _sync_positions(mode, jp, jv, m, order, count, eta, center, pos, vel, vdep, state.box)
+    _sync_kicked(mode, jp, jv, m, order, count, eta, center, pos, vel, vdep, state.box)
     _interaction(mode, t, jp, state, kick_model, work, m, order, count, eta, mu, center, acc,
                  ja0, kick_com)
     eps = h * h / 12.0
@@ -658,7 +835,7 @@ def _lazy_corrector(cc, h, mode, t, jp, jv, state, kick_model, work, m, order, c
     for j in range(count):
         for k in range(dim):
             shifted[k, j] = jp[k, j] + (eps * ja0[k, j] if j >= first else 0.0)
-    _sync_positions(mode, shifted, jv, m, order, count, eta, center, pos, vel, False, state.box)
+    _sync_kicked(mode, shifted, jv, m, order, count, eta, center, pos, vel, False, state.box)
     _interaction(mode, t, shifted, state, kick_model, work, m, order, count, eta, mu, center,
                  acc, ja, kick_com)
     f = 12.0 * cc * h
@@ -667,9 +844,20 @@ def _lazy_corrector(cc, h, mode, t, jp, jv, state, kick_model, work, m, order, c
             jv[k, j] += f * (ja[k, j] - ja0[k, j])
 
 
+@jit(error_model="numpy", inline="always")
+def _lazy(kicking, lazy, cc, h, t, state, kick_model, work, mode, m, order, count, center,
+          columns, rows, acc, kick_com, vdep):
+    """SABA's corrector with coefficient ``cc``, when the scene has one (``lazy`` its address,
+    0: none; ``kicking`` None: nothing to kick, so zero, see ``_steps``)."""
+    if kicking is not None:
+        if lazy != 0:
+            _call_lazy(lazy, (cc, h, t, state, kick_model, work, mode, m, order, count, center,
+                              columns, rows, acc, kick_com, vdep))
+
+
 @jit(error_model="numpy")
 def advance(t, h, steps, state, kick_model, work, vdep, t_end, mode, order, m, G, mu_attractor,
-            center, attracted, kick_com, kernel, corrector, drifts, kicks, cc):
+            center, attracted, kick_com, kernel, corrector, drifts, kicks, cc, addresses):
     """``steps`` steps of ``h`` of the splitting ``drifts[0] kicks[0] drifts[1] ... kicks[S-1]
     drifts[S]`` (fractions of h; Kepler drifts, interaction kicks; see the module).
 
@@ -677,7 +865,8 @@ def advance(t, h, steps, state, kick_model, work, vdep, t_end, mode, order, m, G
     masses the coordinates use (test particles 0); ``attracted[i]`` whether the attractor acts
     on particle i (ATTRACTOR mode); ``corrector`` the symplectic corrector's table
     (``corrector_table``), applied when the call starts and undone when it ends; ``cc`` the
-    coefficient of SABA's lazy corrector applied at both ends of every step (0: none). The
+    coefficient of SABA's lazy corrector applied at both ends of every step (0: none);
+    ``addresses`` the compiled functions the scene and scheme use (``_addresses``). The
     last drift of a step and the first of the next are merged when no corrector stands
     between them. Returns ``(t, h, done, status)`` as every integrator does; on a non-finite
     state the last finite one is restored, synchronised."""
@@ -687,23 +876,18 @@ def advance(t, h, steps, state, kick_model, work, vdep, t_end, mode, order, m, G
     count = order.shape[0]
     if count == 0 or steps == 0:
         return t, h, 0, OK
-    # every scratch array made here, once: the loop below runs without reference counting
-    # (the columns' arrays cut from one allocation: a fresh call allocates little)
+    # every scratch array made here, once: the loop runs without reference counting (the
+    # columns' arrays cut from one allocation: a fresh call allocates little)
     columns = np.empty((9, dim, count))
-    jp, jv, save_p, save_v = columns[0], columns[1], columns[2], columns[3]
-    shifted, ja, ja0 = columns[4], columns[5], columns[6]
-    xs, ad = columns[7], columns[8]  # JACOBI_GRAVITY: inertial positions, accelerations
     rows = np.empty((4, count))
-    eta, mu = rows[0], rows[1]
-    mo = rows[2:]  # masses and 1 / eta by column
     acc = np.empty((dim, state.n))
     kw = np.empty((SCRATCH_ROWS, max(count, dim)))  # the Kepler drift's
     first_p = pos.copy()  # the call's starting state: kept bit for bit if its first step fails
     first_v = vel.copy()
-    return _steps(t, h, steps, state, kick_model, work, vdep, mode, order, m, G, mu_attractor,
-                  center, attracted, kick_com, kernel, corrector, drifts, kicks, cc, jp, jv,
-                  save_p, save_v, shifted, ja, ja0, eta, mu, acc, kw, mo, xs, ad, first_p,
-                  first_v)
+    return _call_steps(addresses[STEPS], (
+        t, h, steps, state, kick_model, work, vdep, mode, order, m, G, mu_attractor, center,
+        attracted, kick_com, kernel, corrector, drifts, kicks, cc, addresses, columns, rows,
+        acc, kw, first_p, first_v))
 
 
 @jit(error_model="numpy", inline="always")
@@ -721,8 +905,9 @@ CHECKPOINT_STEPS = 64
 
 
 @jit(error_model="numpy", inline="always")
-def _gravity_step(jp, jv, mo, count, massive, eta, mu, G, xs, ad, ja, kw, kick, d):
-    """One step of ``_gravity_steps``: the interaction's kick, then the drift ``d``."""
+def _gravity_step(jp, jv, mo, count, massive, eta, mu, G, xs, ad, ja, kw, kick, d, addresses):
+    """One step of ``_gravity_steps``: the interaction's kick, then the drift ``d`` (the one
+    compiled with ``known`` True, a constant; ``_addresses``)."""
     dim = jp.shape[0]
     _gravity_interaction(jp, mo, count, massive, eta, mu, G, xs, ad, ja, kw)
     for k in range(dim):  # by rows: 258-263 -> 247-254 ns a step, against by columns
@@ -730,17 +915,17 @@ def _gravity_step(jp, jv, mo, count, massive, eta, mu, G, xs, ad, ja, kw, kick, 
             jv[k, j] += kick * ja[k, j]
     for k in range(dim):
         jp[k, 0] += d * jv[k, 0]
-    drift_columns(jp, jv, 1, count, mu, d, kw, True)
+    _call_drift(addresses[DRIFT_KNOWN], (jp, jv, 1, count, mu, d, kw, addresses[FALLBACK]))
 
 
-@jit(error_model="numpy", _nrt=False)
-def _gravity_steps(t, h, steps, jp, jv, save_p, save_v, mo, count, massive, eta, mu, G, xs, ad,
-                   ja, kw, kick, merged, last):
+@jit(error_model="numpy", _nrt=False, **_CALLED)
+def _gravity_steps(t, h, steps, columns, rows, kw, count, massive, G, kicks, drifts, split, box,
+                   addresses):
     """``_steps``' loop for its most common case (mutual gravity alone, the standard kernel,
-    one kick a step and no corrector between steps: ``whfast`` on planets), the same
-    operations in the same order, so the same bits. Returns ``(t, done, bad)``, ``bad`` the
-    first column that is not finite after the step that failed (-1: none), and then the state
-    that step started from in ``save_p``, ``save_v``, as ``_steps`` keeps it.
+    one kick a step and no corrector between steps: ``whfast`` on planets; slot ``LOOP``),
+    the same operations in the same order, so the same bits. Returns ``(t, done, bad)``,
+    ``bad`` the first column that is not finite after the step that failed (-1: none), and
+    then the state that step started from in ``save_p``, ``save_v``, as ``_steps`` keeps it.
 
     Why a loop of its own: inside ``_steps``, which takes every mode, scheme and corrector, the
     same step of the outer solar system ran slower than in this small function (642 against
@@ -751,6 +936,13 @@ def _gravity_steps(t, h, steps, jp, jv, save_p, save_v, mo, count, massive, eta,
     the steps from the last save to it are taken again, the same operations on the same
     numbers, so the state the failing step started from is found bit for bit at a cost paid
     only on failure."""
+    jp, jv, save_p, save_v = columns[0], columns[1], columns[2], columns[3]
+    ja, xs, ad = columns[5], columns[7], columns[8]
+    eta, mu = rows[0], rows[1]
+    mo = rows[2:]
+    kick = kicks[0] * h
+    merged = (drifts[1] + drifts[0]) * h  # the last drift of a step and the first of the next
+    last = drifts[1] * h
     done = 0
     since = CHECKPOINT_STEPS
     for step in range(steps):
@@ -758,14 +950,15 @@ def _gravity_steps(t, h, steps, jp, jv, save_p, save_v, mo, count, massive, eta,
             _save_columns(jp, jv, save_p, save_v, count)
             since = 0
         d = last if step == steps - 1 else merged
-        _gravity_step(jp, jv, mo, count, massive, eta, mu, G, xs, ad, ja, kw, kick, d)
+        _gravity_step(jp, jv, mo, count, massive, eta, mu, G, xs, ad, ja, kw, kick, d,
+                      addresses)
         since += 1
         if not all_finite(jp, jv, count):
             bad = _first_bad_column(jp, jv, count)
             _save_columns(save_p, save_v, jp, jv, count)
             for _ in range(since - 1):  # the steps before the failing one: none was the last
                 _gravity_step(jp, jv, mo, count, massive, eta, mu, G, xs, ad, ja, kw, kick,
-                              merged)
+                              merged, addresses)
             _save_columns(jp, jv, save_p, save_v, count)
             return t, done, bad
         t = t + h
@@ -773,26 +966,45 @@ def _gravity_steps(t, h, steps, jp, jv, save_p, save_v, mo, count, massive, eta,
     return t, done, -1
 
 
-@jit(error_model="numpy", _nrt=False)
-def _free_steps(t, h, steps, jp, jv, save_p, save_v, count, mu, kw, merged, last, box):
+@jit(error_model="numpy", inline="always")
+def _free_step(jp, jv, mu, count, h, drifts, final, split, kw, box, addresses):
+    """One step of ``_free_steps``: its drifts, the last merged with the next step's first
+    unless the step is the call's ``final`` one or SABA's corrector stands between them
+    (``split``), as ``_steps`` takes them."""
+    stages = drifts.shape[0] - 1
+    for s in range(1, stages):
+        _kepler_drift(ATTRACTOR, jp, jv, mu, count, drifts[s] * h, kw, box, addresses)
+    last = drifts[stages]
+    d = last * h if final or split else (last + drifts[0]) * h
+    _kepler_drift(ATTRACTOR, jp, jv, mu, count, d, kw, box, addresses)
+    if split and not final:
+        _kepler_drift(ATTRACTOR, jp, jv, mu, count, drifts[0] * h, kw, box, addresses)
+
+
+@jit(error_model="numpy", _nrt=False, **_CALLED)
+def _free_steps(t, h, steps, columns, rows, kw, count, massive, G, kicks, drifts, split, box,
+                addresses):
     """``_steps``' loop when nothing is kicked (ATTRACTOR mode, the attractor the only term:
-    test particles about a star, a lone Kepler orbit) and no corrector stands between steps:
-    each step one Kepler drift per column, as ``_gravity_steps`` for its case, with its
-    saved states every ``CHECKPOINT_STEPS`` steps."""
+    test particles about a star, a lone Kepler orbit; slot ``LOOP``): each step its Kepler
+    drifts per column (SABA's corrector, ``split``, and the symplectic correctors are zero
+    without an interaction, but SABA's keeps a step's last drift apart from the next one's
+    first), as ``_gravity_steps`` for its case, with its saved states every
+    ``CHECKPOINT_STEPS`` steps."""
+    jp, jv, save_p, save_v = columns[0], columns[1], columns[2], columns[3]
+    mu = rows[1]
     done = 0
     since = CHECKPOINT_STEPS
     for step in range(steps):
         if since == CHECKPOINT_STEPS:
             _save_columns(jp, jv, save_p, save_v, count)
             since = 0
-        _kepler_drift(ATTRACTOR, jp, jv, mu, count, last if step == steps - 1 else merged, kw,
-                      box)
+        _free_step(jp, jv, mu, count, h, drifts, step == steps - 1, split, kw, box, addresses)
         since += 1
         if not all_finite(jp, jv, count):
             bad = _first_bad_column(jp, jv, count)
             _save_columns(save_p, save_v, jp, jv, count)
             for _ in range(since - 1):
-                _kepler_drift(ATTRACTOR, jp, jv, mu, count, merged, kw, box)
+                _free_step(jp, jv, mu, count, h, drifts, False, split, kw, box, addresses)
             _save_columns(jp, jv, save_p, save_v, count)
             return t, done, bad
         t = t + h
@@ -800,85 +1012,103 @@ def _free_steps(t, h, steps, jp, jv, save_p, save_v, count, mu, kw, merged, last
     return t, done, -1
 
 
-@jit(error_model="numpy", _nrt=False)
+@jit(error_model="numpy", _nrt=False, **_CALLED)
 def _steps(t, h, steps, state, kick_model, work, vdep, mode, order, m, G, mu_attractor, center,
-           attracted, kick_com, kernel, corrector, drifts, kicks, cc, jp, jv, save_p, save_v,
-           shifted, ja, ja0, eta, mu, acc, kw, mo, xs, ad, first_p, first_v):
-    """``advance``'s work in the scratch it made, compiled without reference counting (it
-    allocates nothing), as are the operators it calls: a call passing a dozen arrays would
-    otherwise pay two atomic updates per array, more than a small system's physics. The
-    operators are called, not inlined, so that each is compiled once."""
+           attracted, kick_com, kernel, corrector, drifts, kicks, cc, addresses, columns, rows,
+           acc, kw, first_p, first_v, kicking=None):
+    """``advance``'s work in the scratch it made (slot ``STEPS``), compiled without reference
+    counting (it allocates nothing), as are the operators it calls: a call passing a dozen
+    arrays would otherwise pay two atomic updates per array, more than a small system's
+    physics. ``columns`` holds the coordinates' arrays (positions, velocities, their saved
+    copies, shifted positions, two interaction accelerations, and JACOBI_GRAVITY's inertial
+    positions and accelerations), ``rows`` eta, mu, and the masses and 1 / eta by column.
+
+    ``kicking`` is None or True, a constant compiled in (``_slot_address``'s ``defaults``):
+    None for a scene with nothing to kick (ATTRACTOR mode, the attractor the only term), whose
+    version has no kicks or correctors, the branches on it taken out before the code is typed
+    (numba prunes a test of an argument against None, not against another constant). So the
+    lone orbit of ``python -m engine`` compiles no kick, corrector or force table; the other
+    scenes share one version (one for each mode compiled 8 s more for a process with
+    several, to save 2 s for one with a single mode, measured)."""
     pos = state.pos
     vel = state.vel
     dim = pos.shape[0]
     count = order.shape[0]
     stages = kicks.shape[0]
+    jp, jv, save_p, save_v = columns[0], columns[1], columns[2], columns[3]
+    eta, mu = rows[0], rows[1]
+    mo = rows[2:]
+    lazy = addresses[LAZY]
     massive = 0
     for j in range(count):
         mo[0, j] = m[order[j]] if mode != ATTRACTOR else 0.0
         if mo[0, j] > 0.0:
             massive = j + 1  # the massive bodies come first
     t0 = t
-    _coordinates(mode, pos, vel, m, order, count, center, jp, jv, eta, state.box)
+    _coordinates(kicking, mode, pos, vel, m, order, count, center, jp, jv, eta, state.box)
     kepler_parameters(mode, m, order, count, eta, G, mu_attractor, attracted, mu)
     for j in range(count):
         mo[1, j] = 1.0 / eta[j] if mode != ATTRACTOR else 0.0
-    _corrector(corrector, 1.0, h, mode, t, jp, jv, state, kick_model, work, m, order, count,
-               eta, mu, center, acc, ja, kick_com, kw, shifted, vdep, mo, xs, ad, massive, G)
+    if kicking is not None:
+        _corrector(corrector, 1.0, h, t, state, kick_model, work, mode, m, order, count, center,
+                   columns, rows, acc, kw, kick_com, vdep, massive, G, addresses)
     if cc != 0.0:
-        _lazy_corrector(cc, h, mode, t, jp, jv, state, kick_model, work, m, order, count, eta,
-                        mu, center, acc, ja, kick_com, shifted, ja0, vdep)
-    _kepler_drift(mode, jp, jv, mu, count, drifts[0] * h, kw, state.box)
+        _lazy(kicking, lazy, cc, h, t, state, kick_model, work, mode, m, order, count, center,
+              columns, rows, acc, kick_com, vdep)
+    _kepler_drift(mode, jp, jv, mu, count, drifts[0] * h, kw, state.box, addresses)
     done = 0
     status = OK
     if not all_finite(jp, jv, count):  # after this, each step's end is checked
         status = order[_first_bad_column(jp, jv, count)]
         steps = 0
-    # the two common cases take their own loops (see there); the loop below takes the rest
-    common = cc == 0.0 and stages == 1 and status == OK
+    # the two common cases take their own loops (see there; ``_addresses`` gives
+    # ``_gravity_steps`` only with no SABA corrector and one kick a step, ``_free_steps`` to
+    # every scene with nothing to kick); the loop below takes the rest
+    loop = addresses[LOOP]
     bad = -1
-    if common and mode == JACOBI_GRAVITY and kernel == KERNEL_STANDARD:
-        t, done, bad = _gravity_steps(t, h, steps, jp, jv, save_p, save_v, mo, count, massive,
-                                      eta, mu, G, xs, ad, ja, kw, kicks[0] * h,
-                                      (drifts[1] + drifts[0]) * h, drifts[1] * h)
-        steps = 0
-    elif common and mode == ATTRACTOR and kick_model.kinds.shape[0] == 0:
-        t, done, bad = _free_steps(t, h, steps, jp, jv, save_p, save_v, count, mu, kw,
-                                   (drifts[1] + drifts[0]) * h, drifts[1] * h, state.box)
+    if loop != 0 and status == OK:
+        t, done, bad = _call_loop(loop, (t, h, steps, columns, rows, kw, count, massive, G,
+                                         kicks, drifts, cc != 0.0, state.box, addresses))
         steps = 0
     if bad >= 0:
         status = order[bad]
-    for step in range(steps):
-        _save_columns(jp, jv, save_p, save_v, count)
-        elapsed = drifts[0]
-        for s in range(stages):
-            _kick_step(mode, t + elapsed * h, kicks[s] * h, jp, jv, state, kick_model, work,
-                       m, order, count, eta, mu, center, acc, ja, kick_com, kernel, shifted,
-                       vdep, mo, xs, ad, massive, G, kw)
-            if s < stages - 1:
-                _kepler_drift(mode, jp, jv, mu, count, drifts[s + 1] * h, kw, state.box)
-                elapsed += drifts[s + 1]
-        last = drifts[stages]
-        if step == steps - 1 or cc != 0.0:
-            _kepler_drift(mode, jp, jv, mu, count, last * h, kw, state.box)
-            if cc != 0.0:
-                _lazy_corrector(cc if step == steps - 1 else 2.0 * cc, h, mode, t + h, jp, jv,
-                                state, kick_model, work, m, order, count, eta, mu, center,
-                                acc, ja, kick_com, shifted, ja0, vdep)
-                if step < steps - 1:
-                    _kepler_drift(mode, jp, jv, mu, count, drifts[0] * h, kw, state.box)
-        else:
-            _kepler_drift(mode, jp, jv, mu, count, (last + drifts[0]) * h, kw, state.box)
-        if not all_finite(jp, jv, count):
-            status = order[_first_bad_column(jp, jv, count)]
-            break
-        t = t + h
-        done += 1
+    # a scene with nothing to kick has had all its steps in ``_free_steps``: its version of this
+    # function has no loop here
+    if kicking is not None:
+        for step in range(steps):
+            _save_columns(jp, jv, save_p, save_v, count)
+            elapsed = drifts[0]
+            for s in range(stages):
+                _kick_at(addresses, t + elapsed * h, kicks[s] * h, state, kick_model, work,
+                         mode, m, order, count, center, columns, rows, acc, kw, kick_com, kernel,
+                         vdep, massive, G)
+                if s < stages - 1:
+                    _kepler_drift(mode, jp, jv, mu, count, drifts[s + 1] * h, kw, state.box,
+                                  addresses)
+                    elapsed += drifts[s + 1]
+            last = drifts[stages]
+            if step == steps - 1 or cc != 0.0:
+                _kepler_drift(mode, jp, jv, mu, count, last * h, kw, state.box, addresses)
+                if cc != 0.0:
+                    _lazy(kicking, lazy, cc if step == steps - 1 else 2.0 * cc, h, t + h, state,
+                          kick_model, work, mode, m, order, count, center, columns, rows, acc,
+                          kick_com, vdep)
+                    if step < steps - 1:
+                        _kepler_drift(mode, jp, jv, mu, count, drifts[0] * h, kw, state.box,
+                                      addresses)
+            else:
+                _kepler_drift(mode, jp, jv, mu, count, (last + drifts[0]) * h, kw, state.box,
+                              addresses)
+            if not all_finite(jp, jv, count):
+                status = order[_first_bad_column(jp, jv, count)]
+                break
+            t = t + h
+            done += 1
     if status == OK:
-        _corrector(corrector, -1.0, h, mode, t, jp, jv, state, kick_model, work, m, order,
-                   count, eta, mu, center, acc, ja, kick_com, kw, shifted, vdep, mo, xs,
-                   ad, massive, G)
-        _sync_positions(mode, jp, jv, m, order, count, eta, center, pos, vel, True, state.box)
+        if kicking is not None:
+            _corrector(corrector, -1.0, h, t, state, kick_model, work, mode, m, order, count,
+                       center, columns, rows, acc, kw, kick_com, vdep, massive, G, addresses)
+        _sync(kicking, mode, jp, jv, m, order, count, eta, center, pos, vel, True, state.box)
         if all_finite(pos, vel, state.n):
             return t, h, done, OK
         status = order[0]
@@ -891,14 +1121,14 @@ def _steps(t, h, steps, state, kick_model, work, vdep, mode, order, m, G, mu_att
             for k in range(dim):
                 jp[k, j] = save_p[k, j]
                 jv[k, j] = save_v[k, j]
-        _kepler_drift(mode, jp, jv, mu, count, -drifts[0] * h, kw, state.box)
+        _kepler_drift(mode, jp, jv, mu, count, -drifts[0] * h, kw, state.box, addresses)
         if cc != 0.0:
-            _lazy_corrector(-cc, h, mode, t, jp, jv, state, kick_model, work, m, order, count,
-                            eta, mu, center, acc, ja, kick_com, shifted, ja0, vdep)
-        _corrector(corrector, -1.0, h, mode, t, jp, jv, state, kick_model, work, m, order,
-                   count, eta, mu, center, acc, ja, kick_com, kw, shifted, vdep, mo, xs,
-                   ad, massive, G)
-        _sync_positions(mode, jp, jv, m, order, count, eta, center, pos, vel, True, state.box)
+            _lazy(kicking, lazy, -cc, h, t, state, kick_model, work, mode, m, order, count,
+                  center, columns, rows, acc, kick_com, vdep)
+        if kicking is not None:
+            _corrector(corrector, -1.0, h, t, state, kick_model, work, mode, m, order, count,
+                       center, columns, rows, acc, kw, kick_com, vdep, massive, G, addresses)
+        _sync(kicking, mode, jp, jv, m, order, count, eta, center, pos, vel, True, state.box)
         if all_finite(pos, vel, state.n):
             return t, h, done, status
     for k in range(dim):  # nothing finite to stop at after the start: the start, unchanged
@@ -1063,8 +1293,10 @@ class Plan:
     def kernel_tail(self, name, corrector, kernel, saba):
         """The arguments of ``advance`` after ``t_end`` for integrator ``name`` (``whfast``
         with ``corrector`` and ``kernel``, or ``saba`` with method ``saba``), converted to the
-        types its compiled version takes; made once per plan and setting, since a simulation
-        stepping in short calls would otherwise rebuild them every call."""
+        types its compiled version takes, the last the addresses of the compiled functions the
+        scene and scheme use (``_addresses``: compiled, or loaded, on their first use in the
+        process); made once per plan and setting, since a simulation stepping in short calls
+        would otherwise rebuild them every call."""
         key = (name, corrector, kernel, saba)
         tail = self._tails.get(key)
         if tail is None:
@@ -1075,8 +1307,13 @@ class Plan:
                     f"corrector (got integrator={name!r}, corrector={corrector!r}, "
                     f"kernel={kernel!r}): the correctors, the lazy kernel and SABA are built for "
                     "Jacobi coordinates; nothing was changed")
+            scheme = _scheme_tail(*key)
+            kernel_code, _, _, kicks, cc = scheme
+            free = self.mode == ATTRACTOR and self.kick_model.kinds.shape[0] == 0
+            addresses = _addresses(free, int(self.mode), kernel_code, kicks.shape[0] == 1,
+                                   cc != 0.0)
             tail = (int(self.mode), self.order, self.masses, float(self.G), float(self.mu),
-                    self.center, self.attracted, bool(self.kick_com)) + _scheme_tail(*key)
+                    self.center, self.attracted, bool(self.kick_com)) + scheme + (addresses,)
             self._tails[key] = tail
         return tail
 
