@@ -863,22 +863,24 @@ HOW_THE_TARGETS_ARE_MET = """How the engine gets there (the figures are this run
   `python -m engine` compiles its integrators in one process per core on its first run, and
   `python -m engine compile` / `spacewar compile` fill the cache ahead (CI runs them). The
   tables under section 5 list what each command compiles, function by function.
-- **What is left in compiling** (measured on this machine on 2026-12-05, in one process:
-  `python -m validation compile-times`). The tour compiles for about 125 s of CPU, the first
-  match for 27 s. Most of it is numba's own front end, not LLVM's optimiser: with LLVM's
-  optimisation off (`NUMBA_OPT=0`) the tour still compiles for about 100 s, and of
-  `ias15._advance`'s 24 s, typing, inlining its `inline="always"` helpers and rebuilding SSA
-  form take 14 s, lowering and LLVM 10 s. numba also links each callee's optimised code into
-  its caller's module and optimises and emits it again there: `ias15.advance`, which only
-  allocates scratch and calls `_advance`, spends 7.6 s in lowering, most of it `_advance`'s
-  code a second time. And one Wisdom-Holman kernel serves every coordinate mode, corrector and
-  SABA variant, so that a Kepler problem compiles the code of all of them (about 60 s for
-  `whfast` and `saba` together, the longest of the tour's tasks: compiling ahead on two cores
-  cannot finish before it). What each command compiled and never used before this work is
-  gone: all ten force kernels inlined into every integrator (four copies in the
-  Wisdom-Holman kick), the fused-gravity executor in scenes that cannot take it, numba's
-  formatting of shape errors in `rk4` and `rk45`, a second specialisation per constant
-  argument.
+- **What compiling costs now** (measured on this machine on 2026-12-05, one process,
+  `python -m validation compile-times`; the tables below). The tour compiles for 56 s of CPU
+  (275 s before this work), the first match for 25 s (57 s). numba links a compiled callee's
+  code into every caller and optimises and emits it again there, up the whole chain: the
+  Wisdom-Holman kernels therefore call their operators (steps loop, kick, lazy corrector,
+  drift, the drift's fallback) through addresses made in Python for the scene's mode and
+  scheme (`engine/address_calls.py`, as the force table calls its kernels), so each operator
+  is compiled once and a scene compiles only the ones it uses (a Kepler problem: 62 s of
+  Wisdom-Holman and drift code before, 14 s now); IAS15 runs in one kernel without
+  reference counting.
+  What is left is mostly numba's own front end, not LLVM's optimiser: with LLVM's
+  optimisation off (`NUMBA_OPT=0`) the tour still compiles for 48 s, and typing, inlining and
+  lowering each integrator's loop is what remains. The game's frame (`spacewar.core.step_match`,
+  10 s) is compiled once and inlined by LLVM into its three callers. What each command compiled
+  and never used before this work is gone: all ten force kernels inlined into every integrator
+  (four copies in the Wisdom-Holman kick), the fused-gravity executor in scenes that cannot
+  take it, numba's formatting of shape errors in `rk4` and `rk45`, a second specialisation per
+  constant argument.
 - **Not done.** A vectorised kernel that uses Newton's third law (each pair once) would halve
   the large-N work again; numba gives no way to tell LLVM the reaction writes do not overlap
   the reads, and the three formulations tried (scalar, split into vectorisable passes, one
