@@ -16,6 +16,11 @@ process that made them: they are never pickled or sent elsewhere.
 from numba import types
 from numba.core.errors import TypingError
 
+#: the C-contiguous array types the functions called through addresses are compiled for
+F8_1D = types.Array(types.float64, 1, "C")
+F8_2D = types.Array(types.float64, 2, "C")
+I8_1D = types.Array(types.int64, 1, "C")
+
 
 def check_call(given, wanted, what):
     """Refuse, at compile time, a call through an address whose arguments are not of the
@@ -51,4 +56,4 @@ def entry_address(dispatcher, signature):
     return compiled.library.get_pointer_to_function(compiled.fndesc.llvm_func_name)
 
 
-__all__ = ["call_at", "check_call", "entry_address"]
+__all__ = ["F8_1D", "F8_2D", "I8_1D", "call_at", "check_call", "entry_address"]

@@ -24,12 +24,7 @@ import numpy as np
 from numba import types
 from numba.extending import intrinsic
 
-from ..address_calls import call_at, check_call, entry_address
-
-_F8_1D = types.Array(types.float64, 1, "C")
-_F8_2D = types.Array(types.float64, 2, "C")
-_I8_1D = types.Array(types.int64, 1, "C")
-_B_1D = types.Array(types.boolean, 1, "C")
+from ..address_calls import F8_1D, F8_2D, I8_1D, call_at, check_call, entry_address
 
 
 @functools.lru_cache(maxsize=None)
@@ -45,9 +40,9 @@ def argument_types():
                          np.zeros(1), np.zeros(1, dtype=np.bool_), np.zeros(1, dtype=np.bool_),
                          np.zeros(1, dtype=np.bool_), 1, 0.0))
     work = typeof(Workspace(np.zeros(1), np.zeros(1, dtype=np.int64), False))
-    head = (types.float64, state, _F8_1D, types.int64, types.int64, _I8_1D, types.int64,
+    head = (types.float64, state, F8_1D, types.int64, types.int64, I8_1D, types.int64,
             types.int64)
-    return head + (_F8_2D, work), head
+    return head + (F8_2D, work), head
 
 
 @intrinsic

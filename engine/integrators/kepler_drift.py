@@ -35,7 +35,7 @@ import numpy as np
 from numba import types
 from numba.extending import intrinsic
 
-from ..address_calls import call_at, check_call, entry_address
+from ..address_calls import F8_1D, F8_2D, call_at, check_call, entry_address
 from ..cache import jit
 
 from ..analytic import kepler_step
@@ -335,10 +335,8 @@ def drift_columns(jp, jv, first, count, mu, dt, kw, known=False):
 # (``fallback_address``, made in Python and passed down as an int64), it is compiled once.
 
 
-_F8_1D = types.Array(types.float64, 1, "C")
-_F8_2D = types.Array(types.float64, 2, "C")
 #: the types ``drift_column`` is compiled for when called through its address
-FALLBACK_ARGUMENTS = (_F8_2D, _F8_2D, types.int64, types.float64, types.float64, _F8_1D, _F8_1D)
+FALLBACK_ARGUMENTS = (F8_2D, F8_2D, types.int64, types.float64, types.float64, F8_1D, F8_1D)
 
 
 @functools.lru_cache(maxsize=None)
