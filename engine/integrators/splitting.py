@@ -22,7 +22,7 @@ same operations, bit for bit, without the general machinery's cost per step.
 import numpy as np
 from ..cache import jit
 
-from ..forces.dispatch import accelerations, accelerations_inline
+from ..forces.dispatch import accelerations
 from . import fused_gravity
 from .common import OK, all_finite, copy_state, drift, fill_active_mask, first_nonfinite, kick
 
@@ -89,25 +89,29 @@ def advance_general(t, h, steps, state, model, work, vdep, t_end, drifts, kicks)
     scratch = np.empty((scratch_rows(state.pos.shape[0]), state.n))
     # the force table called, not inlined: inlined into this loop it made a step of the Kepler
     # problem about 4x slower (475 against 122 ns, symplectic Euler, same bits)
-    return _advance_general(t, h, steps, state, model, work, vdep, drifts, kicks, scratch, True)
+    return _advance_general(t, h, steps, state, model, work, vdep, drifts, kicks, scratch,
+                            accelerations)
 
 
 @jit(error_model="numpy", _nrt=False, inline="always")
-def advance_general_in(t, h, steps, state, model, work, vdep, drifts, kicks, scratch):
-    """``advance`` by the general executor alone (every term through the dispatch table; the
-    fused path gives the same bits for the scenes it takes), in caller-owned ``scratch`` of
-    at least ``scratch_rows(dim)`` rows and ``n`` columns, compiled without reference
-    counting (``_nrt=False``, as the force kernels are: it allocates nothing) and inlined
-    into its caller with the force table: a compiled caller stepping many small systems (the
-    game's matches) allocates nothing per system and pays no call per system."""
-    return _advance_general(t, h, steps, state, model, work, vdep, drifts, kicks, scratch, False)
+def advance_general_in(t, h, steps, state, model, work, vdep, drifts, kicks, scratch, accelerate):
+    """``advance`` by the general executor alone (the fused path gives the same bits for the
+    scenes it takes), in caller-owned ``scratch`` of at least ``scratch_rows(dim)`` rows and
+    ``n`` columns, with the caller's force function ``accelerate(t, state, model, acc, work)``
+    (``engine.forces.dispatch.accelerations_inline``, or one that names the terms its caller
+    always declares, so that their kernels are inlined). Compiled without reference counting
+    (``_nrt=False``, as the force kernels are: it allocates nothing) and inlined into its
+    caller: a compiled caller stepping many small systems (the game's matches) allocates
+    nothing per system and pays no call per system."""
+    return _advance_general(t, h, steps, state, model, work, vdep, drifts, kicks, scratch,
+                            accelerate)
 
 
 @jit(error_model="numpy", inline="always")
-def _advance_general(t, h, steps, state, model, work, vdep, drifts, kicks, scratch, call_forces):
-    """The general executor, every declared force through the dispatch table: called
-    (``call_forces``, a constant of each caller) or inlined into the loop, the same
-    arithmetic either way."""
+def _advance_general(t, h, steps, state, model, work, vdep, drifts, kicks, scratch, accelerate):
+    """The general executor, the forces of every declared term from ``accelerate`` (called,
+    or inlined into the loop by a caller that passes an inlined function: the same
+    arithmetic either way)."""
     pos = state.pos
     vel = state.vel
     active = state.active
@@ -134,10 +138,7 @@ def _advance_general(t, h, steps, state, model, work, vdep, drifts, kicks, scrat
                 fresh = False
             if kicks[s] != 0.0:
                 if not fresh:
-                    if call_forces:
-                        accelerations(t_pos, state, model, acc, work)
-                    else:
-                        accelerations_inline(t_pos, state, model, acc, work)
+                    accelerate(t_pos, state, model, acc, work)
                     fresh = True
                 kick(vel, acc, mask, n, kicks[s] * h)
                 if vdep:
