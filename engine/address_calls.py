@@ -46,9 +46,22 @@ def call_at(context, builder, address, restype, wanted, given, args):
     return value
 
 
+#: with numba's JIT off (``NUMBA_DISABLE_JIT=1``: everything runs as the Python it is written
+#: in, for a debugger or a coverage tool), the functions an "address" stands for: its index here
+_PYTHON_FUNCTIONS = {}
+
+
+def python_function(address):
+    """With the JIT off, the Python function ``entry_address`` gave ``address`` for."""
+    return list(_PYTHON_FUNCTIONS)[address]
+
+
 def entry_address(dispatcher, signature):
     """Compile (or load from the cache) ``dispatcher`` for ``signature`` (a numba signature
-    with its return type); the address of its compiled function."""
+    with its return type); the address of its compiled function. With the JIT off, the
+    function's index for ``python_function``."""
+    if not hasattr(dispatcher, "overloads"):  # NUMBA_DISABLE_JIT=1: a plain function
+        return _PYTHON_FUNCTIONS.setdefault(dispatcher, len(_PYTHON_FUNCTIONS))
     compiled = dispatcher.overloads.get(signature.args)
     if compiled is None:
         dispatcher.compile(signature)
@@ -56,4 +69,5 @@ def entry_address(dispatcher, signature):
     return compiled.library.get_pointer_to_function(compiled.fndesc.llvm_func_name)
 
 
-__all__ = ["F8_1D", "F8_2D", "I8_1D", "call_at", "check_call", "entry_address"]
+__all__ = ["F8_1D", "F8_2D", "I8_1D", "call_at", "check_call", "entry_address",
+           "python_function"]

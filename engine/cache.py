@@ -387,6 +387,8 @@ def jit(signature=None, **options):
 
     def decorate(function):
         dispatcher = numba.njit(cache=False, **options)(function)
+        if not hasattr(dispatcher, "py_func"):  # NUMBA_DISABLE_JIT=1: the function as written
+            return dispatcher
         dispatcher._cache = _cache_classes()(function)
         if options.get("inline", "never") == "never":
             _call_types(dispatcher, fixed)

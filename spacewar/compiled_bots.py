@@ -75,9 +75,10 @@ about eightfold (to about 7-10 us a decision). :func:`decide` allocates one smal
 per call for them (``new_scratch``), :func:`decide_all` one per chunk of matches.
 """
 import math
+from fractions import Fraction
 
 import numpy as np
-from numba import prange
+from numba import config as numba_config, prange
 from numba.core import types
 from numba.extending import intrinsic
 
@@ -137,6 +138,14 @@ def fma(typingctx, x, y, z):
     def codegen(context, builder, signature, args):
         return builder.fma(args[0], args[1], args[2])
     return sig, codegen
+
+
+if numba_config.DISABLE_JIT:  # the bots as plain Python (NUMBA_DISABLE_JIT=1, for tracing)
+    def fma(x, y, z):  # noqa: F811 - an intrinsic cannot run in Python
+        """``x y + z`` with one rounding: exact rationals, rounded once by int / int."""
+        if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z)):
+            return x * y + z
+        return float(Fraction(x) * Fraction(y) + Fraction(z))
 
 
 @jit(inline="always", **NUMERIC)

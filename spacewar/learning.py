@@ -76,8 +76,8 @@ def torpedo_slots(rules):
 
     The same formula as the compiled code's, run by Python: reading a policy file validates
     its layout through this, and need not start numba's JIT (about 48 MiB resident) to do so."""
-    return int(slots_in_flight.py_func(int(rules.torpedoes), int(rules.torpedo_life),
-                                       int(rules.reload)))
+    plain = getattr(slots_in_flight, "py_func", slots_in_flight)  # NUMBA_DISABLE_JIT=1: itself
+    return int(plain(int(rules.torpedoes), int(rules.torpedo_life), int(rules.reload)))
 
 
 def learning_length(rules):

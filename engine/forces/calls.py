@@ -21,10 +21,11 @@ makes one from the terms, in the process that steps).
 import functools
 
 import numpy as np
-from numba import types
+from numba import config, types
 from numba.extending import intrinsic
 
-from ..address_calls import F8_1D, F8_2D, I8_1D, call_at, check_call, entry_address
+from ..address_calls import (F8_1D, F8_2D, I8_1D, call_at, check_call, entry_address,
+                             python_function)
 
 
 @functools.lru_cache(maxsize=None)
@@ -70,6 +71,15 @@ def call_potential(typingctx, address, t, state, params, f0, f1, indices, i0, i1
     def codegen(context, builder, signature, args):
         return call_at(context, builder, args[0], types.float64, wanted, given, args[1:])
     return types.float64(address, *given), codegen
+
+
+if config.DISABLE_JIT:  # the kernels are plain functions (``entry_address``): call them so
+    def call_accumulate(address, t, state, params, f0, f1, indices, i0, i1, acc,  # noqa: F811
+                        work):
+        python_function(address)(t, state, params, f0, f1, indices, i0, i1, acc, work)
+
+    def call_potential(address, t, state, params, f0, f1, indices, i0, i1):  # noqa: F811
+        return python_function(address)(t, state, params, f0, f1, indices, i0, i1)
 
 
 @functools.lru_cache(maxsize=None)

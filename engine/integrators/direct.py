@@ -29,6 +29,8 @@ def call(dispatcher, args):
             _check(dispatcher, args)
         return entry(*args)
     result = dispatcher(*args)
+    if not hasattr(dispatcher, "overloads"):  # NUMBA_DISABLE_JIT=1: a plain function
+        return result
     signature = tuple(dispatcher.typeof_pyval(a) for a in args)
     compiled = dispatcher.overloads.get(signature)
     if compiled is not None:

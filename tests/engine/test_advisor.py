@@ -1,8 +1,9 @@
 """engine.advise: on the four problems of the issue (the outer solar system over 1e5 days, Kepler
 e = 0.9 over 100 orbits, a star with 200 test particles over 20 orbits, the Pythagorean problem
 to t = 30), at several error levels, with all candidates and with those that take any scene
-(no whfast, saba), the advised setting run to t_end must reach the requested error (within 3x)
-at a cost within 2x of the cheapest setting a small full sweep finds.
+(no whfast, saba), the advised setting run to t_end must reach the requested error (within 2x;
+documented: 1.9x) at a cost within 1.3x (documented: 1.22x) of the cheapest setting a small full
+sweep finds.
 
 The sweep runs every candidate method to t_end at step counts 1, 2, 4, 8, ... over the span
 (adaptive methods at tolerances 1e-3, 1e-4, ...), from coarse to fine, and keeps the first
@@ -129,8 +130,13 @@ def check_problem(problem, t_end, target, metric, methods=None):
                f"{advice.advisor_seconds:.2f} s work {advice.advisor_work:.4g}\n"
                + advice.table())
     print(figures)
-    assert actual_error <= 3.0 * target, figures
-    assert actual_work <= 2.0 * best_work, figures
+    # docs/engine.md and engine/advisor.py: at most 1.9 (1.86) times the requested error, at
+    # 0.62 to 1.22 times the sweep's cheapest work, over the 31 cases of the advisor's harness.
+    # Measured on the development machine in this file's 11 cases: error/target 0.0 to 1.86 (the
+    # outer solar system at 1e-5), work/best 0.62 to 1.05. Bounded at the documented figures
+    # with small margins (costs are counted work, never time: these are deterministic).
+    assert actual_error <= 2.0 * target, figures
+    assert actual_work <= 1.3 * best_work, figures
     return advice
 
 

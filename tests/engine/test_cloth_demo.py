@@ -9,10 +9,9 @@ import pytest
 from engine import __main__ as cli
 from engine import cloth_demo
 
-PIL = pytest.importorskip("PIL.Image")
 
-
-def test_the_demo_writes_a_gif_with_the_frames_asked_for(tmp_path, capsys):
+def test_the_demo_writes_a_gif_with_the_frames_asked_for(tmp_path, capsys, optional):
+    PIL = optional("PIL.Image")
     out = tmp_path / "cloth.gif"
     cli.main(["cloth", "--out", str(out), "--frames", "4", "--grid", "6", "--width", "160",
               "--height", "120"])
@@ -27,7 +26,8 @@ def test_the_demo_writes_a_gif_with_the_frames_asked_for(tmp_path, capsys):
     assert not [p for p in tmp_path.iterdir() if p.name != "cloth.gif"]  # no temporary left
 
 
-def test_the_scene_hangs_from_its_pins_at_a_fraction_of_the_stable_step(tmp_path):
+def test_the_scene_hangs_from_its_pins_at_a_fraction_of_the_stable_step(tmp_path, optional):
+    optional("PIL")  # run draws the GIF
     summary = cloth_demo.run(tmp_path / "c.gif", frames=3, grid=5, width=80, height=60,
                              log=lambda *a: None)
     assert 0.0 < summary["dt"] <= cloth_demo.SAFETY * summary["stable_dt"]

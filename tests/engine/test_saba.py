@@ -11,8 +11,6 @@ from engine import Simulation, forces
 from engine.integrators import wisdom_holman
 from validation import problems
 
-rebound = pytest.importorskip("rebound")
-
 DT = 100.0  # days
 
 REBOUND_TYPES = {"SABA1": "1", "SABA2": "2", "SABA3": "3", "SABA4": "4", "SABAC1": "CL_1",
@@ -28,6 +26,8 @@ def solar(method, dt=DT):
 
 def rebound_solar(method, steps, dt=DT):
     p = problems.outer_solar_system()
+    # imported here, not at module level: the tests that never use REBOUND run without it
+    rebound = pytest.importorskip("rebound")
     r = rebound.Simulation()
     r.G = p.G
     for m, x, v in zip(p.mass, p.pos, p.vel):
@@ -83,16 +83,21 @@ def _perturbed_error(method, dt, eps, t_end=30.0):
     return np.abs(run(method, dt) - run("SABA(10,6,4)", dt / 16)).max()
 
 
-@pytest.mark.parametrize("method, order", [("SABA1", 2), ("SABA2", 2), ("SABAC2", 4),
-                                           ("SABA(10,6,4)", 4)])
-def test_convergence_in_the_step_follows_the_last_order(method, order):
+@pytest.mark.parametrize("method, order, eps", [("SABA1", 2, 1e-3), ("SABA2", 2, 1e-3),
+                                                ("SABAC2", 4, 1e-3), ("SABA(10,6,4)", 4, 0.03)])
+def test_convergence_in_the_step_follows_the_last_order(method, order, eps):
     """SABAn's error is O(eps h^2n + eps^2 h^2): at eps = 1e-3 the eps^2 h^2 term dominates
     once h is small, and the corrector removes it (SABACn: O(eps h^2n + eps^2 h^4));
-    SABA(10,6,4)'s is O(eps h^10 + eps^2 h^6 + eps^3 h^4)."""
-    steps = [2 * math.pi / k for k in (10, 20)]
-    e = [_perturbed_error(method, h, 1e-3) for h in steps]
+    SABA(10,6,4)'s is O(eps h^10 + eps^2 h^6 + eps^3 h^4), whose last term dominates only at
+    a heavier planet (at eps = 1e-3 its error reaches round-off first).
+
+    At 40 and 80 steps an orbit, measured on the development machine: slopes 2.00, 1.98, 4.03
+    (eps 1e-3) and 4.04 (eps 0.03); at 10 and 20 steps they were still 2.31, 5.37, 9.07, 6.71,
+    short of the asymptote. Two-sided, within 0.1 of the order."""
+    steps = [2 * math.pi / k for k in (40, 80)]
+    e = [_perturbed_error(method, h, eps) for h in steps]
     slope = math.log(e[0] / e[1]) / math.log(2.0)
-    assert slope > order - 0.5, (e, slope)
+    assert slope == pytest.approx(order, abs=0.1), (e, slope)
 
 
 def test_the_generalised_order_method_beats_the_textbook_one_at_the_same_cost():

@@ -10,8 +10,12 @@ class Raising:
 
 
 class Slow:
+    """Sleeps 0.4 s an action (tests/spacewar/test_match.py gives it a 0.1 s budget)."""
+
+    SECONDS = 0.4
+
     def act(self, obs):
-        time.sleep(0.03)
+        time.sleep(self.SECONDS)
         return Action()
 
 

@@ -330,18 +330,34 @@ class Networker:
 
 
 class Writer:
-    """Tries to write next to its own source file and into the project."""
+    """Tries to write each path of ``TARGETS`` (set by the test; by default next to its own
+    source file, into the project and into /tmp) and, as the control, a file of its own
+    scratch directory (its working directory), each read back after writing; prints
+    ``writer: {path: "WRITTEN", or "BLOCKED <error>"}`` with every attempt it made."""
+
+    TARGETS = None
+    CONTROL = "writer-control.txt"
 
     def reset(self):
         import spacewar
 
-        def write(path):
-            with open(path, "w") as f:
-                f.write("x")
-
-        paths = (os.path.join(os.path.dirname(os.path.abspath(__file__)), "planted.txt"),
-                 os.path.join(os.path.dirname(spacewar.__file__), "planted.py"), "/tmp/planted")
-        _report("WRITTEN", {path: (lambda p=path: write(p)) for path in paths})
+        targets = self.TARGETS
+        if targets is None:
+            targets = (os.path.join(os.path.dirname(os.path.abspath(__file__)), "planted.txt"),
+                       os.path.join(os.path.dirname(spacewar.__file__), "planted.py"),
+                       "/tmp/planted")
+        outcome = {}
+        for path in list(targets) + [os.path.join(os.getcwd(), self.CONTROL)]:
+            mark = f"written by the writer to {path}"
+            try:
+                with open(path, "w") as f:
+                    f.write(mark)
+                with open(path) as f:
+                    back = f.read()
+                outcome[path] = "WRITTEN" if back == mark else f"READ BACK {back[:40]!r}"
+            except OSError as exc:
+                outcome[path] = f"BLOCKED {type(exc).__name__}"
+        print("writer:", repr(outcome), flush=True)
 
     def act(self, obs):
         return NOOP

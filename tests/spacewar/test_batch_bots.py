@@ -173,8 +173,9 @@ def test_only_bots_that_can_share_a_game_are_played_together(tmp_path):
 
 
 @pytest.fixture(scope="module")
-def policy_file(tmp_path_factory):
-    pytest.importorskip("jax")
+def policy_file(tmp_path_factory, optional):
+    optional("jax")
+    optional("optax")
     from spacewar import train
 
     config = train.TrainConfig(seed=3)
@@ -201,8 +202,9 @@ def test_a_policy_file_plays_together_as_its_bot_plays_alone(policy_file):
     assert PolicyBot(policy_file).policy.frame_skip > 1  # the holding is exercised
 
 
-def test_a_policy_file_is_the_envs_opponent_as_its_bot_would_play(policy_file, tmp_path):
-    pytest.importorskip("gymnasium")
+def test_a_policy_file_is_the_envs_opponent_as_its_bot_would_play(policy_file, tmp_path,
+                                                                  optional):
+    optional("gymnasium")
     import shutil
 
     from spacewar import envs

@@ -6,23 +6,27 @@ import json
 import os
 import signal
 import threading
-import time
 from pathlib import Path
 
 import pytest
 
-distributed = pytest.importorskip("distributed")
+from engine import cluster
+from spacewar import cluster_play
+from spacewar.bots import BotLoadError
+from spacewar.tournament import run_tournament
 
-from engine import cluster  # noqa: E402
-from spacewar import cluster_play  # noqa: E402
-from spacewar.bots import BotLoadError  # noqa: E402
-from spacewar.tournament import run_tournament  # noqa: E402
+from . import held_task
 
 HOSTILE = str(Path(__file__).with_name("hostile_bots.py"))
 
 
 @pytest.fixture(scope="module")
-def dask_cluster():
+def distributed(optional):
+    return optional("distributed")
+
+
+@pytest.fixture(scope="module")
+def dask_cluster(distributed):
     cluster.warm_up(["spacewar.tournament:warm_up_game"])  # the workers then only load
     with distributed.LocalCluster(n_workers=2, processes=True, threads_per_worker=1,
                                   dashboard_address=":0") as local:
@@ -53,9 +57,17 @@ def test_the_scheduler_variable_is_read(dask_cluster, monkeypatch):
     assert cluster.scheduler_address(None) is None
 
 
-def test_a_worker_killed_mid_run_changes_nothing(dask_cluster):
+def test_a_worker_killed_mid_run_changes_nothing(dask_cluster, distributed, tmp_path):
+    """The first task to start is held (tests/spacewar/held_task.py) until its worker is
+    killed: the kill certainly interrupts a running task, which Dask then runs again on
+    another worker process, and the report is the local one."""
     bots = ["chaser", "sniper", "dodger", "random"]
     local, _ = run_tournament(bots, games=3, rounds=1, workers=1, progress=False)
+    pids = {nanny.process.process.pid for nanny in dask_cluster.workers.values()}
+    # registered (and removed below) by a client of its own, before and after the run: the
+    # run's client runs on its own thread
+    with distributed.Client(dask_cluster.scheduler_address) as client:
+        client.register_plugin(held_task.HoldFirstTask(tmp_path), name="hold-first-task")
     out = {}
 
     def run():
@@ -67,24 +79,23 @@ def test_a_worker_killed_mid_run_changes_nothing(dask_cluster):
 
     thread = threading.Thread(target=run)
     thread.start()
-    # the scheduler runs in this process: read which worker is computing a task, and kill
-    # that worker's process (a second client in this process would share the run's loop)
-    scheduler = dask_cluster.scheduler
-    pids = {nanny.worker_address: nanny.process.process.pid
-            for nanny in dask_cluster.workers.values()}
-    killed = False
-    deadline = time.monotonic() + 120
-    while not killed and thread.is_alive() and time.monotonic() < deadline:
-        busy = [ts.processing_on.address for ts in list(scheduler.tasks.values())
-                if ts.state == "processing" and ts.processing_on is not None]
-        if busy and busy[0] in pids:
-            os.kill(pids[busy[0]], signal.SIGKILL)
-            killed = True
-        time.sleep(0.02)
-    thread.join(300)
-    assert killed, "no task was seen running: the test killed nothing"
+    try:
+        started = tmp_path / held_task.STARTED
+        assert held_task.wait_for(started, 300), "no task started on the cluster"
+        pid, key = started.read_text().split()
+        assert int(pid) in pids  # a worker process, held inside its task
+        os.kill(int(pid), signal.SIGKILL)
+    finally:
+        (tmp_path / held_task.RELEASE).touch()
+        thread.join(600)
+        with distributed.Client(dask_cluster.scheduler_address) as client:
+            client.unregister_worker_plugin("hold-first-task")
+    assert not thread.is_alive()
     assert "error" not in out, out["error"]
     assert _json(out["report"]) == _json(local)
+    # the held task never finished where it was killed: it was run again by another process
+    done = [line.split() for line in (tmp_path / held_task.DONE).read_text().splitlines()]
+    assert [p for k, p in done if k == key] and all(p != pid for k, p in done if k == key)
 
 
 def test_a_worker_with_other_code_is_refused(dask_cluster):
@@ -130,8 +141,8 @@ def test_a_league_on_the_cluster_writes_the_local_file_byte_for_byte(dask_cluste
     assert (tmp_path / "cluster.json").read_bytes() == (tmp_path / "local.json").read_bytes()
 
 
-def test_a_validation_sweep_on_the_cluster_is_the_local_one(dask_cluster):
-    pytest.importorskip("rebound")
+def test_a_validation_sweep_on_the_cluster_is_the_local_one(dask_cluster, optional):
+    optional("rebound")
     from validation import report
     from validation.settings import LEVELS
 
@@ -147,7 +158,7 @@ def test_a_validation_sweep_on_the_cluster_is_the_local_one(dask_cluster):
     assert results(scheduler=dask_cluster.scheduler_address) == results(workers=1)
 
 
-def test_an_unreachable_scheduler_is_a_clear_error(capsys):
+def test_an_unreachable_scheduler_is_a_clear_error(capsys, distributed):
     import dask
 
     from spacewar.cli import main
@@ -158,7 +169,7 @@ def test_an_unreachable_scheduler_is_a_clear_error(capsys):
     assert "no Dask scheduler answered at 'tcp://127.0.0.1:9'" in capsys.readouterr().err
 
 
-def test_a_scheduler_without_workers_is_a_clear_error(monkeypatch):
+def test_a_scheduler_without_workers_is_a_clear_error(monkeypatch, distributed):
     monkeypatch.setattr(cluster, "WORKER_WAIT", 2)
     with distributed.LocalCluster(n_workers=0, dashboard_address=":0") as empty:
         with pytest.raises(cluster.SchedulerUnreachable, match="has had no worker for 2 s"):

@@ -2,16 +2,26 @@
 import numpy as np
 import pytest
 
-gymnasium = pytest.importorskip("gymnasium")
-
-import spacewar.envs as envs  # noqa: E402  (registers Spacewar-v0)
-from spacewar.bots.chaser import Chaser  # noqa: E402
-from spacewar.rules import Rules  # noqa: E402
+from spacewar.bots.chaser import Chaser
+from spacewar.rules import Rules
 
 CAP = 40  # frames: episodes end by truncation, at a known step
 
 
-def _lockstep(mode, steps, num_envs=3, seed=11):
+@pytest.fixture(scope="module")
+def gymnasium(optional):
+    return optional("gymnasium")
+
+
+@pytest.fixture(scope="module")
+def envs(gymnasium):
+    """spacewar.envs (importing it registers Spacewar-v0)."""
+    import spacewar.envs
+
+    return spacewar.envs
+
+
+def _lockstep(envs, mode, steps, num_envs=3, seed=11):
     """The same seeded run under next-step autoreset and under ``mode``, step by step."""
     ref = envs.SpacewarVectorEnv(num_envs, opponent="random", max_frames=CAP)
     other = envs.SpacewarVectorEnv(num_envs, opponent="random", max_frames=CAP,
@@ -20,8 +30,8 @@ def _lockstep(mode, steps, num_envs=3, seed=11):
     return ref, other, actions, ref.reset(seed=seed)[0], other.reset(seed=seed)[0]
 
 
-def test_same_step_autoreset_returns_the_next_episode_and_the_final_observation():
-    ref, same, actions, o_ref, o_same = _lockstep("same_step", 2 * CAP + 4)
+def test_same_step_autoreset_returns_the_next_episode_and_the_final_observation(envs, gymnasium):
+    ref, same, actions, o_ref, o_same = _lockstep(envs, "same_step", 2 * CAP + 4)
     assert same.metadata["autoreset_mode"] == gymnasium.vector.AutoresetMode.SAME_STEP
     np.testing.assert_array_equal(o_ref, o_same)
     k = 0
@@ -49,8 +59,8 @@ def test_same_step_autoreset_returns_the_next_episode_and_the_final_observation(
     assert ends == 1 and k == CAP
 
 
-def test_disabled_autoreset_waits_for_a_reset_mask():
-    ref, off, actions, _, _ = _lockstep("disabled", CAP + 1)
+def test_disabled_autoreset_waits_for_a_reset_mask(envs):
+    ref, off, actions, _, _ = _lockstep(envs, "disabled", CAP + 1)
     for a in actions[:CAP]:
         ref.step(a)
         obs, _, _, truncated, _ = off.step(a)
@@ -71,7 +81,7 @@ def test_disabled_autoreset_waits_for_a_reset_mask():
         off.reset(options={"reset_mask": np.ones(2, dtype=bool)})
 
 
-def test_the_flat_discrete_actions_play_the_same_game():
+def test_the_flat_discrete_actions_play_the_same_game(envs, gymnasium):
     multi = envs.SpacewarVectorEnv(4, opponent="random", max_frames=300)
     flat = envs.SpacewarVectorEnv(4, opponent="random", max_frames=300, action_type="discrete")
     assert flat.single_action_space == gymnasium.spaces.Discrete(24)
@@ -84,7 +94,7 @@ def test_the_flat_discrete_actions_play_the_same_game():
         np.testing.assert_array_equal(a, b)
 
 
-def test_the_electric_mode_has_a_flip_action_that_reverses_the_charge():
+def test_the_electric_mode_has_a_flip_action_that_reverses_the_charge(envs, gymnasium):
     rules = Rules(mode="electric")
     env = envs.SpacewarEnv(opponent="idle", rules=rules, max_frames=100)
     assert env.action_space == gymnasium.spaces.MultiDiscrete([3, 2, 2, 2, 2])
@@ -112,7 +122,7 @@ class _Constant:
         return np.full(len(obs), self.code, dtype=np.int64)
 
 
-def test_a_batch_policy_plays_every_match_from_seat_ones_observations():
+def test_a_batch_policy_plays_every_match_from_seat_ones_observations(envs):
     policy = _Constant(3)  # thrust only
     vec = envs.SpacewarVectorEnv(5, opponent=policy, max_frames=200)
     obs, _ = vec.reset(seed=2)
@@ -128,7 +138,7 @@ def test_a_batch_policy_plays_every_match_from_seat_ones_observations():
         bad.step(np.ones((2, 4), dtype=np.int64))
 
 
-def test_a_python_bot_object_can_be_the_single_envs_opponent():
+def test_a_python_bot_object_can_be_the_single_envs_opponent(envs):
     class Counting(Chaser):
         resets = 0
 
@@ -145,8 +155,8 @@ def test_a_python_bot_object_can_be_the_single_envs_opponent():
     assert Counting.resets == 2
 
 
-def test_rgb_array_rendering_draws_the_match():
-    pytest.importorskip("PIL")
+def test_rgb_array_rendering_draws_the_match(envs, optional):
+    optional("PIL")
     from gymnasium.utils.env_checker import check_env
 
     env = envs.SpacewarEnv(opponent="random", max_frames=200, render_mode="rgb_array")
@@ -159,8 +169,8 @@ def test_rgb_array_rendering_draws_the_match():
     assert (env.render() != first).any()
 
 
-def test_human_rendering_opens_the_window(monkeypatch):
-    pytest.importorskip("pygame")
+def test_human_rendering_opens_the_window(monkeypatch, envs, optional):
+    optional("pygame")
     monkeypatch.setenv("SDL_VIDEODRIVER", "dummy")
     env = envs.SpacewarEnv(opponent="idle", max_frames=20, render_mode="human", size=240)
     env.metadata = {**env.metadata, "render_fps": 0}  # no waiting in a test
@@ -173,7 +183,7 @@ def test_human_rendering_opens_the_window(monkeypatch):
 
 
 @pytest.mark.parametrize("name", ["chaser", "sniper"])
-def test_a_compiled_opponent_decides_as_its_python_twin_inside_the_env(name):
+def test_a_compiled_opponent_decides_as_its_python_twin_inside_the_env(name, envs):
     from spacewar.bots import make_bot
     from spacewar.protocol import action_code
 
@@ -192,7 +202,7 @@ def test_a_compiled_opponent_decides_as_its_python_twin_inside_the_env(name):
     assert agree == total
 
 
-def test_a_compiled_opponent_plays_the_same_whatever_the_batch_size():
+def test_a_compiled_opponent_plays_the_same_whatever_the_batch_size(envs):
     small = envs.SpacewarVectorEnv(2, opponent="chaser", max_frames=300)
     large = envs.SpacewarVectorEnv(5, opponent="chaser", max_frames=300)
     a, _ = small.reset(seed=4)
@@ -206,7 +216,7 @@ def test_a_compiled_opponent_plays_the_same_whatever_the_batch_size():
         np.testing.assert_array_equal(small.batch.actions, large.batch.actions[:2])
 
 
-def test_copy_false_returns_the_batchs_own_buffers_with_the_same_numbers():
+def test_copy_false_returns_the_batchs_own_buffers_with_the_same_numbers(envs):
     copied = envs.SpacewarVectorEnv(3, opponent="random", max_frames=100)
     shared = envs.SpacewarVectorEnv(3, opponent="random", max_frames=100, copy=False)
     a, _ = copied.reset(seed=1)
@@ -220,8 +230,8 @@ def test_copy_false_returns_the_batchs_own_buffers_with_the_same_numbers():
         np.testing.assert_array_equal(a, b)
 
 
-def test_a_reset_mask_under_next_step_autoreset_restarts_only_the_masked_matches():
-    ref, vec, actions, _, _ = _lockstep("next_step", CAP + 2)
+def test_a_reset_mask_under_next_step_autoreset_restarts_only_the_masked_matches(envs):
+    ref, vec, actions, _, _ = _lockstep(envs, "next_step", CAP + 2)
     for a in actions[:CAP]:
         ref.step(a)
         obs, *_ = vec.step(a)
@@ -250,7 +260,7 @@ def test_more_matches_than_chunks_give_the_same_games():
         np.testing.assert_array_equal(getattr(few.game, name), getattr(many.game, name)[:12])
 
 
-def test_a_python_bot_opponent_s_actions_are_played():
+def test_a_python_bot_opponent_s_actions_are_played(envs):
     from spacewar.protocol import action_code
 
     twin = Chaser()
@@ -264,6 +274,6 @@ def test_a_python_bot_opponent_s_actions_are_played():
 
 @pytest.mark.parametrize("field, value", [("max_frames", -1), ("max_frames", 2.5),
                                           ("rounds", 0)])
-def test_bad_lengths_are_refused_at_construction(field, value):
+def test_bad_lengths_are_refused_at_construction(field, value, envs):
     with pytest.raises(ValueError, match=f"{field} must be an int"):
         envs.SpacewarVectorEnv(2, **{field: value})

@@ -2,23 +2,33 @@
 import numpy as np
 import pytest
 
-gymnasium = pytest.importorskip("gymnasium")
+from spacewar.bots.idle import Idle
+from spacewar.learning import learning_length
+from spacewar.rules import Rules
 
-import spacewar.envs as envs  # noqa: E402  (registers Spacewar-v0)
-from spacewar.bots.idle import Idle  # noqa: E402
-from spacewar.learning import learning_length  # noqa: E402
-from spacewar.rules import Rules  # noqa: E402
+
+@pytest.fixture(scope="module")
+def gymnasium(optional):
+    return optional("gymnasium")
+
+
+@pytest.fixture(scope="module")
+def envs(gymnasium):
+    """spacewar.envs (importing it registers Spacewar-v0)."""
+    import spacewar.envs
+
+    return spacewar.envs
 
 
 @pytest.mark.parametrize("opponent", ["idle", "random"])
-def test_the_env_passes_gymnasiums_checker(opponent):
+def test_the_env_passes_gymnasiums_checker(opponent, gymnasium, envs):
     from gymnasium.utils.env_checker import check_env
 
     env = gymnasium.make("Spacewar-v0", opponent=opponent, max_frames=300)
     check_env(env.unwrapped, skip_render_check=True)
 
 
-def test_make_vec_gives_the_native_vector_env_and_its_spaces():
+def test_make_vec_gives_the_native_vector_env_and_its_spaces(envs, gymnasium):
     envs_ = gymnasium.make_vec("Spacewar-v0", num_envs=16, opponent="random", max_frames=200)
     assert isinstance(envs_, envs.SpacewarVectorEnv)
     assert envs_.metadata["autoreset_mode"] == gymnasium.vector.AutoresetMode.NEXT_STEP
@@ -33,7 +43,7 @@ def test_make_vec_gives_the_native_vector_env_and_its_spaces():
     assert ended.all()  # every match was cut at max_frames and restarted
 
 
-def test_self_play_puts_both_seats_on_the_agent_axis():
+def test_self_play_puts_both_seats_on_the_agent_axis(envs):
     vec = envs.SpacewarVectorEnv(8, opponent=None, max_frames=500)
     obs, _ = vec.reset(seed=1)
     assert obs.shape == (8, learning_length(Rules()))
@@ -47,7 +57,7 @@ def test_self_play_puts_both_seats_on_the_agent_axis():
         envs.SpacewarVectorEnv(3, opponent=None)
 
 
-def test_a_seed_fixes_the_run():
+def test_a_seed_fixes_the_run(envs):
     def run(seed):
         vec = envs.SpacewarVectorEnv(4, opponent="random", max_frames=400)
         obs, _ = vec.reset(seed=seed)
@@ -60,7 +70,7 @@ def test_a_seed_fixes_the_run():
     assert not np.array_equal(run(7), run(8))
 
 
-def test_bad_arguments_are_refused():
+def test_bad_arguments_are_refused(envs):
     with pytest.raises(ValueError, match="opponent must be None, one of .*idle.*random"):
         envs.SpacewarVectorEnv(2, opponent="nobody")
     with pytest.raises(ValueError, match="a Python bot keeps state per match"):
@@ -78,16 +88,16 @@ def test_bad_arguments_are_refused():
     np.testing.assert_array_equal(envs.codes_from_parts([[2, 1, 1, 0]]), [2 + 3 + 6])
 
 
-def test_the_parallel_env_passes_pettingzoos_api_and_seed_tests():
-    pytest.importorskip("pettingzoo")
+def test_the_parallel_env_passes_pettingzoos_api_and_seed_tests(envs, optional):
+    optional("pettingzoo")
     from pettingzoo.test import parallel_api_test, parallel_seed_test
 
     parallel_api_test(envs.parallel_env(max_frames=400), num_cycles=500)
     parallel_seed_test(lambda: envs.parallel_env(max_frames=400), num_cycles=300)
 
 
-def test_the_parallel_env_is_a_zero_sum_match_that_ends_for_both():
-    pytest.importorskip("pettingzoo")
+def test_the_parallel_env_is_a_zero_sum_match_that_ends_for_both(envs, optional):
+    optional("pettingzoo")
     env = envs.parallel_env(max_frames=600)
     obs, infos = env.reset(seed=4)
     assert set(obs) == set(envs.AGENTS)

@@ -1,5 +1,13 @@
-"""Tests for spacewar.play: people and bots in the window, run headless with scripted keys."""
+"""Tests for spacewar.play: people and bots in the window, run headless with scripted keys.
+
+No test here reads the wall clock: the window's pace is driven by a fake clock that moves
+only when a picture is drawn (``FakeWallClock``), so how many window ticks (and so game frames)
+each pass of the loop plays, when ``max_seconds`` ends a session and what ``wall_seconds``
+says are exact, whatever the machine's load. Scripts give keys per window tick.
+"""
+import contextlib
 import os
+import types
 
 os.environ["SDL_VIDEODRIVER"] = "dummy"
 os.environ["SDL_AUDIODRIVER"] = "dummy"
@@ -7,21 +15,80 @@ os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
 
 import pytest  # noqa: E402
 
-pygame = pytest.importorskip("pygame")
-
+from engine.clock import FixedStepClock  # noqa: E402
 from spacewar import keys as K  # noqa: E402
 from spacewar import play as play_module  # noqa: E402
 from spacewar import replay as replay_io  # noqa: E402
+from spacewar import viewer  # noqa: E402
 from spacewar.match import play_match  # noqa: E402
 from spacewar.play import action_code, format_summary, play, script_source, watch  # noqa: E402
 from spacewar.protocol import Action  # noqa: E402
 from spacewar.rules import Rules  # noqa: E402
+from spacewar.seats import Limits  # noqa: E402
+
+# A confined bot's budget here: an action of a test bot in its own process took 0.13-0.19 ms
+# at the median and 3.8-5.3 ms at the 99th percentile (measured on this 2-core machine while
+# it ran other test suites: play_match(..., act_seconds=True), 1119-1197 actions each), so
+# 0.6 s is over 100x the p99 and a loaded machine cannot turn an answer into a timeout (and
+# so change the match that ``watch`` is compared with).
+CONFINED = Limits(budget=0.6)
+
+
+class FakeWallClock:
+    """Wall time that moves only when the window shows a picture: each picture takes exactly
+    ``1 / draw_rate`` s (``now = draws / draw_rate``, one correctly rounded division, so
+    ``FixedStepClock``'s tolerance makes every tick count exact)."""
+
+    def __init__(self, draw_rate):
+        self.draw_rate = draw_rate
+        self.draws = 0
+
+    def __call__(self):
+        return self.draws / self.draw_rate
+
+
+@contextlib.contextmanager
+def fake_window_clock(draw_rate=30):
+    """Drive ``spacewar.play``'s window with a ``FakeWallClock``: its pace (``viewer.Pace``'s
+    wall clock, an ``engine.clock.FixedStepClock`` given the fake clock) and ``run_window``'s
+    ``max_seconds`` and ``wall_seconds`` read it, and every ``Window.show`` advances it."""
+    clock = FakeWallClock(draw_rate)
+    real_show = viewer.Window.show
+
+    class FakePace(viewer.Pace):
+        def __init__(self, fps, speed=1.0):
+            super().__init__(fps, speed)
+            real = self.wall  # the same step and cap, on the fake clock
+            self.wall = FixedStepClock(dt=real.dt, max_steps_per_frame=real.max_steps_per_frame,
+                                       clock=clock)
+            self.wall.tick()  # starts the measurement, as Pace does
+
+    def show(self, prims):
+        real_show(self, prims)
+        clock.draws += 1
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(play_module, "Pace", FakePace)
+        mp.setattr(viewer, "time", types.SimpleNamespace(perf_counter=clock))
+        mp.setattr(viewer.Window, "show", show)
+        yield clock
+
+
+@pytest.fixture(autouse=True)
+def window_clock():
+    with fake_window_clock() as clock:
+        yield clock
+
+
+@pytest.fixture(scope="module")
+def pygame():
+    """pygame (the optional [viz] extra), for the tests that open a window."""
+    return pytest.importorskip("pygame")
 
 
 @pytest.fixture(scope="module", autouse=True)
 def compiled_frames():
-    """The compiled frame is compiled (or loaded from the cache) before any test runs against
-    the wall clock, so a first-time compile never eats a test's time limit."""
+    """The compiled frame is compiled (or loaded from the cache) once, before the tests."""
     play_match("chaser", "sniper", rounds=1, rules=Rules(max_round_frames=20, post_round_delay=2))
 
 
@@ -48,32 +115,80 @@ def test_scripts():
         script_source(42)
 
 
-def test_scripted_thrust_and_fire_against_idle():
-    script = [(0, {"w"}), (20, {"w", "space"}), (70, {"a"}), (80, set())]
-    result = play(p2="idle", script=script, max_seconds=3, scale=360)
-    assert result["reason"] == "time"
-    # 60 frames a second for 3 s, less any the clock dropped if drawing fell behind
-    assert 90 <= result["frames"] <= 200
-    assert result["frames"] + result["dropped_steps"] >= 150
-    assert result["torpedoes_fired"][0] >= 3  # fire held 50 frames, reload 16
-    assert result["torpedoes_fired"][1] == 0
+THRUST_AND_FIRE = [(0, {"w"}), (20, {"w", "space"}), (70, {"a"}), (80, set())]
+
+
+def thrust_and_fire(clock, draw_rate):
+    """Three seconds of the fake clock at 60 window ticks a second, drawn ``draw_rate`` times a
+    second: the summary and the number of pictures drawn."""
+    clock.draw_rate = draw_rate
+    result = play(p2="idle", script=THRUST_AND_FIRE, max_seconds=3, scale=360)
+    return result, clock.draws
+
+
+def check_thrust_and_fire(result, draws, draw_rate):
+    """What the session must have done, exactly: the first pass draws before any time has gone
+    by; each later one is ``60 / draw_rate`` ticks late, of which the clock plays at most 6
+    (``Pace``: a tenth of a second at 60 fps) and drops the rest; the pass at 3 s is the last,
+    and the session's time is read after its picture."""
+    passes = 3 * draw_rate  # passes 1 .. 3 * draw_rate each play their ticks
+    due = 60 // draw_rate
+    assert result["reason"] == "time", result["reason"]
+    assert draws == passes + 1, (draws, passes + 1)
+    assert result["wall_seconds"] == draws / draw_rate
+    assert result["frames"] == passes * min(due, 6), result["frames"]
+    assert result["dropped_steps"] == passes * max(due - 6, 0), result["dropped_steps"]
+    assert result["paused_frames"] == 0
+    # fire held from tick 20 to 69 with a reload of 16 frames: shots at 20, 36, 52 and 68
+    assert result["torpedoes_fired"] == [4, 0]
     assert result["distance"][0] > 0.05 > result["distance"][1]  # thrust vs the star's pull
     assert result["scores"] == [0, 0] and not result["over"] and result["winner"] is None
     assert result["bot_faults"] == 0
 
 
-def test_escape_quits_early():
+@pytest.mark.parametrize("draw_rate", [30, 5])
+def test_scripted_thrust_and_fire_against_idle(pygame, window_clock, draw_rate):
+    """At 30 pictures a second every tick is played (180 frames in 3 s); at 5 a second the
+    drawing falls behind and the clock drops half of every pass's 12 ticks (90 played, 90
+    dropped)."""
+    result, draws = thrust_and_fire(window_clock, draw_rate)
+    check_thrust_and_fire(result, draws, draw_rate)
+
+
+def test_the_thrust_and_fire_check_fails_on_a_pace_that_drops_no_ticks(pygame, window_clock,
+                                                                      monkeypatch):
+    """Positive control: with the cap on ticks per pass lifted (a planted bug in the pace),
+    the slow drawing plays every tick and the exact counts above catch it."""
+    real = play_module.Pace
+
+    class Uncapped(real):
+        def __init__(self, fps, speed=1.0):
+            super().__init__(fps, speed)
+            self.wall = FixedStepClock(dt=self.wall.dt, max_steps_per_frame=1000,
+                                       clock=window_clock)
+            self.wall.tick()
+
+    monkeypatch.setattr(play_module, "Pace", Uncapped)
+    result, draws = thrust_and_fire(window_clock, 5)
+    assert (result["frames"], result["dropped_steps"]) == (180, 0)  # not (90, 90)
+    with pytest.raises(AssertionError):
+        check_thrust_and_fire(result, draws, 5)
+
+
+def test_escape_quits_early(pygame, window_clock):
     result = play(p2="idle", script=[(0, {"space"}), (20, {"escape"})], max_seconds=10, scale=256)
     assert result["reason"] == "quit"
     assert result["frames"] == 20
-    assert result["wall_seconds"] < 5
+    # 2 ticks a picture at 30 pictures a second: tick 20 (the escape) is the first of the pass
+    # after the 11th picture; that pass draws the 12th, so 0.4 s went by (of the 10 allowed)
+    assert window_clock.draws == 12 and result["wall_seconds"] == 12 / 30
     # the same with a callable script
     result = play(p2="idle", script=lambda f: {"escape"} if f >= 5 else set(), max_seconds=10,
                   scale=256)
     assert result["reason"] == "quit" and result["frames"] == 5
 
 
-def test_pause_and_resume_by_script():
+def test_pause_and_resume_by_script(pygame):
     script = [(10, {"p"}), (11, set()), (40, {"p"}), (41, set()), (60, {"escape"})]
     result = play(p2="chaser", script=script, max_seconds=10, scale=256)
     assert result["reason"] == "quit"
@@ -81,7 +196,7 @@ def test_pause_and_resume_by_script():
     assert result["frames"] == 30
 
 
-def test_the_real_keyboard_path(monkeypatch):
+def test_the_real_keyboard_path(pygame, monkeypatch):
     """No script: keys come from pygame's key state and events (faked here, headless)."""
     thrust = pygame.K_w
 
@@ -107,7 +222,7 @@ def test_the_real_keyboard_path(monkeypatch):
     assert result["torpedoes_fired"] == [0, 0]
 
 
-def test_a_game_played_to_the_end_returns_the_result():
+def test_a_game_played_to_the_end_returns_the_result(pygame):
     # short rounds that time out: the match ends on its own and play returns
     from spacewar.rules import Rules
 
@@ -144,7 +259,7 @@ def recorded_codes(path):
     return replay_io.actions(replay_io.load(path))
 
 
-def test_two_people_at_one_keyboard_each_fly_their_own_ship(tmp_path):
+def test_two_people_at_one_keyboard_each_fly_their_own_ship(pygame, tmp_path):
     path = tmp_path / "two.json"
     script = [(0, {"w", "left", "down"}),  # player 1 thrusts; player 2 turns left and fires
               (30, {"a", "kp8", "rctrl"}),  # player 1 turns; player 2 on the keypad and RCtrl
@@ -167,7 +282,7 @@ def test_two_people_at_one_keyboard_each_fly_their_own_ship(tmp_path):
     assert result["torpedoes_fired"][1] >= 2 and result["torpedoes_fired"][0] == 0
 
 
-def test_one_person_in_seat_2_gets_both_hands_keys(tmp_path):
+def test_one_person_in_seat_2_gets_both_hands_keys(pygame, tmp_path):
     path = tmp_path / "seat2.json"
     rules = Rules(max_round_frames=40, post_round_delay=0)
     result = play(p1="idle", p2="human", rules=rules, rounds=1, script=[(0, {"left", "w"})],
@@ -179,7 +294,7 @@ def test_one_person_in_seat_2_gets_both_hands_keys(tmp_path):
     assert replay_io.check(replay_io.load(path))[0]
 
 
-def test_a_match_left_before_its_end_writes_no_replay(tmp_path):
+def test_a_match_left_before_its_end_writes_no_replay(pygame, tmp_path):
     path = tmp_path / "left.json"
     result = play(p2="idle", script=[(0, {"w"}), (30, {"escape"})], max_seconds=20, scale=256,
                   record_to=path)
@@ -212,10 +327,11 @@ def test_the_key_sets_do_not_share_a_key():
 
 # -- watching two bots --------------------------------------------------------------------------
 @pytest.fixture(scope="module")
-def watched(tmp_path_factory):
+def watched(pygame, tmp_path_factory):
     path = tmp_path_factory.mktemp("watch") / "watched.json"
-    summary = watch("chaser", "sniper", seed=7, rounds=1, fps=240, speed=8.0, scale=256,
-                    script=[], max_seconds=120, record_to=path)
+    with fake_window_clock():  # module-scoped: the function-scoped clock is not yet in place
+        summary = watch("chaser", "sniper", seed=7, rounds=1, fps=240, speed=8.0, scale=256,
+                        script=[], max_seconds=120, record_to=path)
     return summary, path
 
 
@@ -249,7 +365,7 @@ def test_the_summary_is_a_table(watched):
     assert "{" not in text
 
 
-def test_a_bot_from_elsewhere_plays_confined_exactly_as_in_a_match(monkeypatch):
+def test_a_bot_from_elsewhere_plays_confined_exactly_as_in_a_match(pygame, monkeypatch):
     from spacewar.seats import InlineSeat, ProcessSeat
 
     opened = []
@@ -262,26 +378,27 @@ def test_a_bot_from_elsewhere_plays_confined_exactly_as_in_a_match(monkeypatch):
     monkeypatch.setattr(play_module, "open_seat", spy)
     spec = "tests.spacewar.bots_for_tests:SometimesRaising"  # faults on frames 5, 6 and 7
     summary = watch(spec, "idle", seed=3, rounds=1, fps=240, speed=8.0, scale=256, script=[],
-                    max_seconds=120)
+                    max_seconds=120, limits=CONFINED)
     assert isinstance(opened[0], ProcessSeat) and isinstance(opened[1], InlineSeat)
-    result, _, _ = play_match(spec, "idle", seed=3, rounds=1)
+    result, _, _ = play_match(spec, "idle", seed=3, rounds=1, limits=CONFINED)
     assert summary["result"] == result
     assert summary["faults"] == [3, 0] and summary["bot_faults"] == 3
     assert [ex["frame"] for ex in result["faults"][0]["examples"]] == [5, 6, 7]
 
 
-def test_a_bot_that_faults_too_often_forfeits_the_watched_match():
+def test_a_bot_that_faults_too_often_forfeits_the_watched_match(pygame):
     spec = "tests.spacewar.bots_for_tests:Raising"
     summary = watch(spec, "chaser", seed=1, rounds=1, max_faults=3, fps=240, scale=256,
-                    script=[], max_seconds=120)
+                    script=[], max_seconds=120, limits=CONFINED)
     assert summary["reason"] == "over" and summary["forfeits"] == [True, False]
     assert summary["winner_seat"] == 1 and summary["frames"] == 2
-    result, _, _ = play_match(spec, "chaser", seed=1, rounds=1, max_faults=3)
+    assert summary["result"]["faults"][0]["raised"] == 3  # every fault of its kind
+    result, _, _ = play_match(spec, "chaser", seed=1, rounds=1, max_faults=3, limits=CONFINED)
     assert summary["result"] == result
     assert "yes" in format_summary(summary).splitlines()[4]  # the forfeited row
 
 
-def test_watch_pauses_steps_and_changes_speed():
+def test_watch_pauses_steps_and_changes_speed(pygame):
     script = [(10, {"space"}), (11, set()), (12, {"."}), (13, set()), (14, {"."}),
               (15, set()), (20, {"p"}), (21, set()), (30, {"]"}), (31, set()),
               (40, {"["}), (41, set()), (42, {"["}), (43, set()), (44, {"1"}), (45, set()),
@@ -321,7 +438,7 @@ def test_no_display_is_one_line_and_exit_status_2(argv, monkeypatch, capsys):
     assert opened == []  # found out before any bot started
 
 
-def test_a_video_driver_that_fails_is_the_same_clear_error(monkeypatch, capsys):
+def test_a_video_driver_that_fails_is_the_same_clear_error(pygame, monkeypatch, capsys):
     from spacewar.cli import main
 
     monkeypatch.delenv("DISPLAY", raising=False)
@@ -332,7 +449,7 @@ def test_a_video_driver_that_fails_is_the_same_clear_error(monkeypatch, capsys):
     assert err.startswith("spacewar watch: cannot open a window:") and err.count("\n") == 1
 
 
-def test_a_display_that_is_not_there_is_not_drawn_to_invisibly(monkeypatch, capfd):
+def test_a_display_that_is_not_there_is_not_drawn_to_invisibly(pygame, monkeypatch, capfd):
     from spacewar.cli import main
 
     monkeypatch.delenv("SDL_VIDEODRIVER", raising=False)
@@ -360,7 +477,7 @@ def test_help_lists_the_keys_and_the_defaults(capsys):
             assert text in out, (command, text)
 
 
-def test_watch_from_the_command_line_to_the_end(tmp_path, monkeypatch, capsys):
+def test_watch_from_the_command_line_to_the_end(pygame, tmp_path, monkeypatch, capsys):
     from spacewar import viewer
     from spacewar.cli import main
 
@@ -391,7 +508,7 @@ def test_a_bad_replay_path_is_refused_before_anything_starts(tmp_path, monkeypat
     assert (tmp_path / "keep.gif").read_bytes().startswith(b"GIF89a")
 
 
-def test_a_match_left_before_its_end_names_no_winner():
+def test_a_match_left_before_its_end_names_no_winner(pygame):
     # chaser scores twice against an idle person in the first 1200 frames; quitting there
     # leaves the match unfinished, and the score so far is no win
     summary = play(p2="chaser", fps=600, script=[(1200, {"escape"})], max_seconds=60,

@@ -4,16 +4,20 @@ import os
 import numpy as np
 import pytest
 
-Image = pytest.importorskip("PIL.Image")
-
-from spacewar import render  # noqa: E402
-from spacewar.game import Game  # noqa: E402
-from spacewar.match import play_match  # noqa: E402
-from spacewar.render import Effects, render_frame, render_gif  # noqa: E402
-from spacewar.replay import save  # noqa: E402
-from spacewar.rules import Rules  # noqa: E402
+from spacewar import render
+from spacewar.game import Game
+from spacewar.match import play_match
+from spacewar.render import Effects, render_frame, render_gif
+from spacewar.replay import save
+from spacewar.rules import Rules
 
 SIZE = 320
+
+
+@pytest.fixture(scope="module")
+def Image(optional):
+    """Pillow's Image module, for the tests that draw."""
+    return optional("PIL.Image")
 
 
 @pytest.fixture(scope="module")
@@ -31,6 +35,8 @@ def starless_replay():
 
 def frames_of(path):
     """Every frame of a GIF as an RGB array (Pillow composes the delta frames)."""
+    from PIL import Image
+
     out = []
     with Image.open(path) as im:
         for k in range(im.n_frames):
@@ -44,7 +50,7 @@ def centre(frame, half=1):
     return frame[c - half:c + half + 1, c - half:c + half + 1]
 
 
-def test_gif_of_a_real_match(tmp_path, replay):
+def test_gif_of_a_real_match(tmp_path, replay, Image):
     out = tmp_path / "match.gif"
     info = render_gif(replay, out, every=2, size=SIZE, max_frames=200)
     assert out.exists() and info["bytes"] == out.stat().st_size
@@ -77,7 +83,7 @@ def _umask():
     return mask
 
 
-def test_a_whole_match_to_the_end(tmp_path, replay):
+def test_a_whole_match_to_the_end(tmp_path, replay, Image):
     out = tmp_path / "whole.gif"
     info = render_gif(replay, out, every=4, size=96)
     assert info["game_frames"] == replay["frames"]  # drawn to the last frame
@@ -87,14 +93,14 @@ def test_a_whole_match_to_the_end(tmp_path, replay):
         assert im.info["duration"] >= render.FINAL_HOLD_MS  # the final score stays up a moment
 
 
-def test_no_star_leaves_the_centre_dark(tmp_path, starless_replay):
+def test_no_star_leaves_the_centre_dark(tmp_path, starless_replay, Image):
     out = tmp_path / "nostar.gif"
     render_gif(starless_replay, out, size=SIZE, max_frames=5)
     frames = frames_of(out)
     assert frames and all(centre(f, half=3).max() == 0 for f in frames)
 
 
-def test_every_and_max_frames_and_a_replay_file(tmp_path, replay):
+def test_every_and_max_frames_and_a_replay_file(tmp_path, replay, Image):
     path = tmp_path / "match.json"
     save(path, replay)
     out = tmp_path / "short.gif"
@@ -107,7 +113,7 @@ def test_every_and_max_frames_and_a_replay_file(tmp_path, replay):
         assert im.info["duration"] == 50  # 20 frames a second
 
 
-def test_a_crash_mid_render_leaves_no_partial_file(tmp_path, replay, monkeypatch):
+def test_a_crash_mid_render_leaves_no_partial_file(tmp_path, replay, monkeypatch, Image):
     out = tmp_path / "keep.gif"
     out.write_bytes(b"GIF89a the previous file")  # a GIF may be replaced by a new GIF
     calls = {"n": 0}
@@ -126,7 +132,7 @@ def test_a_crash_mid_render_leaves_no_partial_file(tmp_path, replay, monkeypatch
     assert os.listdir(tmp_path) == ["keep.gif"]
 
 
-def test_fallback_without_the_streaming_encoder(tmp_path, replay, monkeypatch):
+def test_fallback_without_the_streaming_encoder(tmp_path, replay, monkeypatch, Image):
     from PIL import GifImagePlugin
 
     monkeypatch.delattr(GifImagePlugin, "getdata")
@@ -137,7 +143,7 @@ def test_fallback_without_the_streaming_encoder(tmp_path, replay, monkeypatch):
     assert all(centre(f).max() > 100 for f in frames)
 
 
-def test_bad_arguments(tmp_path, replay):
+def test_bad_arguments(tmp_path, replay, Image):
     for kwargs in ({"every": 0}, {"size": 10}, {"fps": 60}, {"fps": 0}, {"max_frames": 0}):
         with pytest.raises(ValueError):
             render_gif(replay, tmp_path / "x.gif", **kwargs)
@@ -157,7 +163,7 @@ def colours(image, below=40):
     return {tuple(int(v) for v in c) for c in np.unique(pixels.reshape(-1, 3), axis=0)}
 
 
-def test_render_frame_draws_the_ships_and_hides_one_in_hyperspace():
+def test_render_frame_draws_the_ships_and_hides_one_in_hyperspace(Image):
     image = render_frame(snapshot(), 400)
     assert image.size == (400, 400) and image.mode == "P"
     assert set(render.SHIP_COLOURS) <= colours(image)
@@ -166,7 +172,7 @@ def test_render_frame_draws_the_ships_and_hides_one_in_hyperspace():
     assert render.SHIP_COLOURS[1] in colours(hidden)
 
 
-def test_flame_and_explosion():
+def test_flame_and_explosion(Image):
     assert render.FLAME_COLOURS[0] in colours(render_frame(snapshot(thrusting=True), 400))
     assert render.FLAME_COLOURS[0] not in colours(render_frame(snapshot(), 400))
     snap = snapshot(alive=False, killed_at=0)
@@ -178,7 +184,7 @@ def test_flame_and_explosion():
     assert not colours(render_frame(snap, 400)) & set(render.FIRE[:4])
 
 
-def test_a_ship_on_the_edge_is_drawn_on_both_sides():
+def test_a_ship_on_the_edge_is_drawn_on_both_sides(Image):
     image = np.asarray(render_frame(snapshot(pos=[-0.499, 0.1], heading=0.0), 400).convert("RGB"))
     blue = (image == render.SHIP_COLOURS[0]).all(axis=2)
     cols = np.flatnonzero(blue.any(axis=0))
@@ -218,7 +224,7 @@ def test_missing_pillow_says_how_to_install(monkeypatch):
         render.require_pillow()
 
 
-def test_single_frame_gif(tmp_path, replay):
+def test_single_frame_gif(tmp_path, replay, Image):
     out = tmp_path / "one.gif"
     info = render_gif(replay, out, size=SIZE, max_frames=1)
     assert info["frames"] == 1
@@ -263,7 +269,7 @@ def test_frame_snapshot_adds_what_the_gauges_need():
         {k: v for k, v in base.items() if k not in ("ships", "torpedoes")}
 
 
-def test_the_gauges_show_mode_fuel_torpedoes_and_charge():
+def test_the_gauges_show_mode_fuel_torpedoes_and_charge(Image):
     size = 480
     top = int(render.hud_bottom(size))
     game = played(Rules(mode="electric"))
@@ -285,7 +291,7 @@ def test_the_gauges_show_mode_fuel_torpedoes_and_charge():
     assert not mask(classic, plus).any() and not mask(classic, minus).any()
 
 
-def test_the_fuel_bar_is_as_long_as_the_fuel_left():
+def test_the_fuel_bar_is_as_long_as_the_fuel_left(Image):
     size = 480
     snap = render.frame_snapshot(Game(Rules(), seeds=[1]))
     lengths = {}
@@ -300,7 +306,7 @@ def test_the_fuel_bar_is_as_long_as_the_fuel_left():
         assert abs(length - fraction * full) <= 2, lengths
 
 
-def test_torpedoes_are_visible_dots_at_480_pixels():
+def test_torpedoes_are_visible_dots_at_480_pixels(Image):
     snap = render.frame_snapshot(Game(Rules(), seeds=[3]))
     snap["torpedoes"] = [{"pos": [0.2, -0.2], "owner": 0, "charge": 0.0}]
     pixels = rgb(render_frame(snap, 480))
@@ -312,7 +318,7 @@ def test_torpedoes_are_visible_dots_at_480_pixels():
     assert abs(rows.mean() - y) < 1 and abs(cols.mean() - x) < 1
 
 
-def test_electric_torpedoes_wear_their_charge():
+def test_electric_torpedoes_wear_their_charge(Image):
     snap = render.frame_snapshot(Game(Rules(mode="electric"), seeds=[3]))
     snap["torpedoes"] = [{"pos": [0.2, -0.2], "owner": 1, "charge": -4e-4}]
     pixels = rgb(render_frame(snap, 480))
@@ -322,7 +328,7 @@ def test_electric_torpedoes_wear_their_charge():
     assert mask(around, render.TORPEDO_COLOURS[1]).sum() >= 12
 
 
-def test_the_gif_shows_the_gauges(tmp_path):
+def test_the_gif_shows_the_gauges(tmp_path, Image):
     _, rep, _ = play_match("chaser", "sniper", seed=2, rounds=1, rules=Rules(mode="electric"),
                            record=True)
     out = tmp_path / "electric.gif"

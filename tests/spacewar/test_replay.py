@@ -276,8 +276,8 @@ def test_save_refuses_to_overwrite_a_gif(tmp_path, clean):
     assert gif.read_bytes() == b"GIF89a keep"
 
 
-def test_render_refuses_to_overwrite_the_replay(tmp_path, clean):
-    pytest.importorskip("PIL")
+def test_render_refuses_to_overwrite_the_replay(tmp_path, clean, optional):
+    optional("PIL")
     from spacewar.render import render_gif
 
     path = saved(tmp_path, clean[1])

@@ -7,15 +7,9 @@ import zipfile
 import numpy as np
 import pytest
 
-pytest.importorskip("gymnasium")
-pytest.importorskip("jax")
-pytest.importorskip("optax")
-
-from spacewar import policy as policy_mod  # noqa: E402
-from spacewar.policy import Policy, PolicyBot, PolicyError, evaluate  # noqa: E402
-from spacewar.rules import Rules  # noqa: E402
-from spacewar import train as train_mod  # noqa: E402
-from spacewar.train import TrainConfig  # noqa: E402
+from spacewar import policy as policy_mod
+from spacewar.policy import Policy, PolicyBot, PolicyError, evaluate
+from spacewar.rules import Rules
 
 # A short seeded run against the random bot, stopped by frames (not the clock) so it is the
 # same run every time on one kind of CPU: 20 M frames, each decision held for 8 frames, about
@@ -24,29 +18,44 @@ from spacewar.train import TrainConfig  # noqa: E402
 # CPU's vector unit: seed 1 won 46 of the 50 matches below on one AMD EPYC (znver4) and 36 on
 # others (znver5), where seeds 2 and 3 won 45 and 42. Measured there for seed 2: the untrained policy
 # wins 2 of the 50 matches, the trained one 45.
-SHORT = TrainConfig(opponent="random", minutes=30.0, steps=20_000_000, seed=2, envs=512,
-                    frame_skip=8)
+SHORT = dict(opponent="random", minutes=30.0, steps=20_000_000, seed=2, envs=512, frame_skip=8)
 
 
 @pytest.fixture(scope="module")
-def trained(tmp_path_factory):
+def train_mod(optional):
+    """spacewar.train, once its optional packages (the [rl] extra) are there."""
+    for name in ("gymnasium", "jax", "optax"):
+        optional(name)
+    from spacewar import train
+
+    return train
+
+
+@pytest.fixture(scope="module")
+def short(train_mod):
+    return train_mod.TrainConfig(**SHORT)
+
+
+@pytest.fixture(scope="module")
+def trained(tmp_path_factory, train_mod, short):
     out = str(tmp_path_factory.mktemp("train") / "policy.npz")
-    result = train_mod.train(SHORT, out, progress=False)
+    result = train_mod.train(short, out, progress=False)
     return out, result
 
 
 @pytest.fixture(scope="module")
-def untrained(tmp_path_factory):
+def untrained(tmp_path_factory, train_mod, short):
     out = str(tmp_path_factory.mktemp("untrained") / "untrained.npz")
-    train_mod.save_params(out, train_mod.initial_params(SHORT), SHORT)
+    train_mod.save_params(out, train_mod.initial_params(short), short)
     return out
 
 
-def test_a_short_run_learns_to_win_where_the_untrained_policy_does_not(trained, untrained):
+def test_a_short_run_learns_to_win_where_the_untrained_policy_does_not(trained, untrained,
+                                                                        short):
     out, result = trained
-    assert result["frames"] >= SHORT.steps and result["updates"] > 0
-    after = evaluate(out, opponent=SHORT.opponent, matches=50, seed=123, rounds=3)
-    before = evaluate(untrained, opponent=SHORT.opponent, matches=50, seed=123, rounds=3)
+    assert result["frames"] >= short.steps and result["updates"] > 0
+    after = evaluate(out, opponent=short.opponent, matches=50, seed=123, rounds=3)
+    before = evaluate(untrained, opponent=short.opponent, matches=50, seed=123, rounds=3)
     assert after["win_rate"] >= 0.8, (after, before)
     assert before["win_rate"] < 0.8, (after, before)
     assert after["wins"] > before["wins"]
@@ -66,7 +75,7 @@ def test_the_policy_bot_wins_real_matches_in_either_seat(trained):
     assert wins >= 5
 
 
-def test_numpy_inference_equals_the_jax_forward_pass(trained, untrained):
+def test_numpy_inference_equals_the_jax_forward_pass(trained, untrained, train_mod):
     out, result = trained
     policy = Policy.load(out)
     rng = np.random.default_rng(0)
@@ -87,18 +96,19 @@ def test_numpy_inference_equals_the_jax_forward_pass(trained, untrained):
         policy.act_batch(obs, greedy=False)
 
 
-def test_the_saved_metadata_describes_the_policy(trained):
+def test_the_saved_metadata_describes_the_policy(trained, short):
     out, _ = trained
     policy = Policy.load(out)
     meta = policy.metadata
     assert meta["format_version"] == policy_mod.FORMAT_VERSION
     assert meta["observation_length"] == 107 and meta["rules"] == Rules().to_dict()
     assert meta["action_format"] == "MultiDiscrete[3,2,2,2]" and meta["activation"] == "tanh"
-    assert meta["frame_skip"] == SHORT.frame_skip and meta["training"]["opponent"] == "random"
+    assert meta["frame_skip"] == short.frame_skip and meta["training"]["opponent"] == "random"
     assert policy.inputs.size == 107 - 2  # the two entries scaled by the number of rounds
 
 
-def test_training_is_deterministic_for_a_seed(tmp_path):
+def test_training_is_deterministic_for_a_seed(tmp_path, train_mod):
+    TrainConfig = train_mod.TrainConfig
     config = TrainConfig(opponent="random", steps=2 * 64 * 32 * 4, seed=7, envs=64)
     a = train_mod.train(config, str(tmp_path / "a.npz"), progress=False)
     b = train_mod.train(config, str(tmp_path / "b.npz"), progress=False)
@@ -112,17 +122,17 @@ def test_training_is_deterministic_for_a_seed(tmp_path):
     assert a["history"][-1]["policy_loss"] == b["history"][-1]["policy_loss"]
 
 
-def test_the_output_path_is_checked_before_training(tmp_path):
+def test_the_output_path_is_checked_before_training(tmp_path, train_mod, short):
     with pytest.raises(ValueError, match="does not exist"):
-        train_mod.train(SHORT, str(tmp_path / "missing" / "p.npz"), progress=False)
+        train_mod.train(short, str(tmp_path / "missing" / "p.npz"), progress=False)
     text = tmp_path / "notes.txt"
     text.write_text("keep me")
     with pytest.raises(ValueError, match="not an .npz"):
-        train_mod.train(SHORT, str(text), progress=False)
+        train_mod.train(short, str(text), progress=False)
     assert text.read_text() == "keep me"
 
 
-def test_gae_matches_the_recursion_by_hand():
+def test_gae_matches_the_recursion_by_hand(train_mod):
     r = np.array([[0.0], [1.0], [0.0]])
     v = np.array([[0.5], [0.2], [0.1]])
     d = np.array([[0.0], [1.0], [0.0]])
@@ -263,9 +273,9 @@ def test_the_policy_bot_refuses_other_rules(untrained):
         bot.act(game.observe(0, 0))
 
 
-def test_the_bot_computes_the_envs_observation(untrained):
+def test_the_bot_computes_the_envs_observation(untrained, optional):
     """What a bot computes from its Observation is what the env showed in training."""
-    import spacewar.envs  # noqa: F401
+    optional("gymnasium")
     from spacewar.envs import SpacewarVectorEnv
     from spacewar.learning import learning_vector
 

@@ -270,10 +270,15 @@ def test_what_the_replay_window_says(classic):
     assert "speed 1x" in view._footer()[0][0] and view.timeline.frame == rep["frames"] - 1
 
 
+@pytest.fixture(scope="module")
+def pygame(optional):
+    return optional("pygame")
+
+
 def scripted_view(rep, script, **options):
+    """The replay window run by ``script`` (its tests ask for the ``pygame`` fixture)."""
     from spacewar.viewer import view_replay
 
-    pytest.importorskip("pygame")
     log = {}
 
     def on_tick(tick, view):
@@ -284,7 +289,7 @@ def scripted_view(rep, script, **options):
     return summary, log
 
 
-def test_replay_window_pauses_steps_speeds_up_and_rewinds_exactly(classic):
+def test_replay_window_pauses_steps_speeds_up_and_rewinds_exactly(classic, pygame):
     rep, hashes = classic
     script = [(30, {"space"}), (31, set()), (40, {"."}), (41, set()), (42, {"."}), (43, set()),
               (44, {","}), (45, set()), (50, {"space"}), (51, {"]"}), (52, set()),
@@ -306,7 +311,7 @@ def test_replay_window_pauses_steps_speeds_up_and_rewinds_exactly(classic):
     assert summary["recorded_end"] is None
 
 
-def test_replay_window_jumps_to_the_end_and_back_to_the_start(classic):
+def test_replay_window_jumps_to_the_end_and_back_to_the_start(classic, pygame):
     rep, hashes = classic
     script = [(2, {"end"}), (3, set()), (5, {"home"}), (6, set()), (8, {"end"}), (9, set()),
               (10, {"left"}), (11, {"escape"})]
@@ -319,7 +324,7 @@ def test_replay_window_jumps_to_the_end_and_back_to_the_start(classic):
     assert summary["state_sha256"] == hashes[summary["frame"]]
 
 
-def test_replay_window_rewinds_past_the_start_only_to_frame_0(classic):
+def test_replay_window_rewinds_past_the_start_only_to_frame_0(classic, pygame):
     rep, hashes = classic
     script = [(0, {"]"}), (1, set()), (2, {"]"}), (3, set()), (10, {"backspace"}),
               (20, {"escape"})]
@@ -329,9 +334,7 @@ def test_replay_window_rewinds_past_the_start_only_to_frame_0(classic):
     assert log[19]["frame"] == 0 and summary["state_sha256"] == hashes[0]
 
 
-def test_clicking_the_bar_jumps_there(classic):
-    import pygame
-
+def test_clicking_the_bar_jumps_there(classic, pygame):
     rep, hashes = classic
 
     def click_at(fraction):
@@ -366,8 +369,7 @@ def test_replay_view_without_a_display_exits_2(classic, tmp_path, monkeypatch, c
     assert err.startswith("spacewar replay: no display:") and "\n" not in err
 
 
-def test_replay_view_from_the_command_line(classic, tmp_path, monkeypatch, capsys):
-    pytest.importorskip("pygame")
+def test_replay_view_from_the_command_line(classic, tmp_path, monkeypatch, capsys, pygame):
     from spacewar import viewer
     from spacewar.cli import main
 

@@ -62,7 +62,14 @@ def test_bench_writes_json_and_markdown_atomically(tmp_path, monkeypatch):
 
 
 # -- the report ---------------------------------------------------------------------------------
-report = pytest.importorskip("validation.report")
+@pytest.fixture(scope="module")
+def report(optional):
+    """validation.report, imported plainly (an ImportError of our own code is a failure), once
+    the matplotlib of its extra is there."""
+    optional("matplotlib")
+    from validation import report
+
+    return report
 
 
 @pytest.mark.parametrize("setup, message", [
@@ -74,7 +81,7 @@ report = pytest.importorskip("validation.report")
      "holds text, not a PNG"),
 ])
 def test_report_refuses_a_bad_output_directory_before_running(tmp_path, monkeypatch, capsys,
-                                                              setup, message):
+                                                              setup, message, report):
     setup(tmp_path)
     monkeypatch.setattr(report, "collect", _no_run)
     with pytest.raises(SystemExit) as info:
@@ -83,14 +90,14 @@ def test_report_refuses_a_bad_output_directory_before_running(tmp_path, monkeypa
     assert message in capsys.readouterr().err
 
 
-def test_report_missing_parent_fails_before_running(monkeypatch, capsys):
+def test_report_missing_parent_fails_before_running(monkeypatch, capsys, report):
     monkeypatch.setattr(report, "collect", _no_run)
     with pytest.raises(SystemExit):
         report.main(["--out", "/proc/version/sub", "--no-progress"])
     assert "not a directory" in capsys.readouterr().err
 
 
-def test_report_files_are_written_atomically(tmp_path, monkeypatch):
+def test_report_files_are_written_atomically(tmp_path, monkeypatch, report):
     out = tmp_path / "out"
     out.mkdir()
     (out / "report.md").write_text("previous report")
@@ -107,9 +114,9 @@ def test_report_files_are_written_atomically(tmp_path, monkeypatch):
     assert json.loads((out / "results.json").read_text()) == res
 
 
-def test_plots_are_written_atomically(tmp_path):
+def test_plots_are_written_atomically(tmp_path, optional):
+    plt = optional("matplotlib.pyplot")
     from validation import plots
-    import matplotlib.pyplot as plt
 
     path = tmp_path / "plot.png"
     path.write_bytes(b"\x89PNG\r\n\x1a\nold")

@@ -8,20 +8,26 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-rebound = pytest.importorskip("rebound")
-
-from validation import crosscheck, drift, hardcases, twobody  # noqa: E402
-from validation.problems import kepler  # noqa: E402
-from validation.reference import ias15_states, kepler_states  # noqa: E402
+from tests.engine.controls_energy import PumpedSim
+from validation import crosscheck, drift, hardcases, twobody
+from validation.problems import kepler
+from validation.reference import ias15_states, kepler_states
 
 ROOT = Path(__file__).resolve().parents[2]
+
+
+@pytest.fixture
+def rebound():
+    """REBOUND, for the tests that run it (directly or through validation's runs): imported
+    here, not at module level, so that the others run without it."""
+    return pytest.importorskip("rebound")
 
 
 # -- the same algorithm in two codes ---------------------------------------------------------------
 
 @pytest.mark.parametrize("problem", [crosscheck.two_massive_bodies(), kepler(0.6)],
                          ids=["two_massive_bodies", "kepler_test_particle"])
-def test_leapfrog_agrees_with_rebound_leapfrog_to_round_off(problem):
+def test_leapfrog_agrees_with_rebound_leapfrog_to_round_off(problem, rebound):
     res = crosscheck.compare(problem, steps_per_orbit=128, orbits=2, sample_every=16,
                              extended=False)
     assert res["steps"] == 256
@@ -30,7 +36,7 @@ def test_leapfrog_agrees_with_rebound_leapfrog_to_round_off(problem):
     assert res["max_rel_vel_difference"] < 1e-12
 
 
-def test_leapfrog_difference_is_the_size_of_each_codes_own_rounding():
+def test_leapfrog_difference_is_the_size_of_each_codes_own_rounding(rebound):
     res = crosscheck.compare(crosscheck.two_massive_bodies(), steps_per_orbit=110, orbits=5)
     if "max_rel_pos_engine_vs_extended" not in res:
         pytest.skip("numpy longdouble is no wider than double here")
@@ -70,7 +76,7 @@ def test_second_order_convergence_of_leapfrog_on_kepler():
     assert math.log2(coarse / fine) == pytest.approx(2.0, abs=0.1)
 
 
-def test_ias15_and_kepler_references_agree():
+def test_ias15_and_kepler_references_agree(rebound):
     p = kepler(0.9)
     times = [p.unit, 10 * p.unit]
     for (r1, v1), (r2, v2) in zip(ias15_states(p, times), kepler_states(p, times)):
@@ -79,18 +85,40 @@ def test_ias15_and_kepler_references_agree():
 
 # -- energy drift classes --------------------------------------------------------------------------
 
-def _drift(integrator, steps_per_orbit, orbits):
+def _drift(integrator, steps_per_orbit, orbits, pump=0.0, monkeypatch=None):
+    """``pump``: the energy pump of ``tests.engine.controls_energy`` planted in every step (the
+    positive control; needs ``monkeypatch``)."""
     p = kepler(0.6)
+    if pump:
+        real = drift.make_sim
+
+        def pumped(*args, **kw):
+            sim = real(*args, **kw)
+            return PumpedSim(sim, pump, mean_kinetic=abs(sim.energy()))
+
+        monkeypatch.setattr(drift, "make_sim", pumped)
     res = drift.run_engine_fixed(p, integrator, p.unit / steps_per_orbit,
                                  steps_per_orbit * orbits, 30,
                                  first_steps=max(1, steps_per_orbit // 100))
-    slope, _, env, destroyed = drift.growth_exponent(res["t"], res["err"])
-    return slope, drift.classify(slope, env), res
+    slope, window, env, destroyed = drift.growth_exponent(res["t"], res["err"])
+    return slope, drift.classify(slope, env, window), res
+
+
+# Leapfrog at 1000 steps an orbit over 1000 orbits (1e6 steps): its bounded error is 5.1e-5,
+# so an energy pump of 1e-10 a step (2e-4 over the run) stands out. At 100 steps an orbit over
+# 200 orbits, as this test once ran, the bounded error is 4.9e-3 and the same pump adds 1.1e-5 of
+# it: growth exponent 2.37e-4 against 2.32e-4 unpumped, "bounded" either way. That run was too
+# short to resolve such a pump; the classifier (slope < 0.25: bounded) is not what let it pass
+# (the report's own runs, 1e5 orbits at 500 steps, put 1e-2 of pumped drift on 2e-4 of bounded
+# error).
+LEAPFROG_RUN = (1000, 1000)
 
 
 def test_drift_classes_on_a_short_run():
-    slope, cls, _ = _drift("leapfrog", 100, 200)
-    assert cls == "bounded" and abs(slope) < 0.1
+    slope, cls, _ = _drift("leapfrog", *LEAPFROG_RUN)
+    # measured on the development machine: -5.8e-17 (the running maximum is flat: reached in
+    # the first orbits)
+    assert cls == "bounded" and abs(slope) < 1e-9, slope
     slope, cls, _ = _drift("rk4", 100, 200)
     assert cls == "linear drift" and slope == pytest.approx(1.0, abs=0.15)
     slope, cls, res = _drift("euler", 100000, 50)
@@ -98,6 +126,14 @@ def test_drift_classes_on_a_short_run():
     err = np.array(res["err"])
     t = np.array(res["t"]) / kepler(0.6).unit
     assert err[-1] > 10 * err[t <= 1.0].max()  # Euler's energy keeps growing
+
+
+def test_drift_class_of_a_pumped_leapfrog_is_not_bounded(monkeypatch):
+    """Positive control: the same leapfrog run with 1e-10 of the kinetic energy pumped in a
+    step is not called bounded. Measured: growth exponent 0.325, "sublinear growth" (unpumped
+    -5.8e-17, "bounded")."""
+    slope, cls, _ = _drift("leapfrog", *LEAPFROG_RUN, pump=1e-10, monkeypatch=monkeypatch)
+    assert cls != "bounded" and slope > 0.25, (cls, slope)
 
 
 def test_growth_exponent_of_synthetic_series():
@@ -130,7 +166,7 @@ def test_coincident_bodies_are_detected_not_skipped():
 
 # -- the command -----------------------------------------------------------------------------------
 
-def test_report_smoke_writes_its_files(tmp_path):
+def test_report_smoke_writes_its_files(tmp_path, rebound):
     from validation import report
     assert report.main(["--out", str(tmp_path), "--smoke", "--workers", "1", "--no-progress"]) == 0
     md = (tmp_path / "report.md").read_text()

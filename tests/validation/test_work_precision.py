@@ -4,13 +4,18 @@ import math
 
 import pytest
 
-rebound = pytest.importorskip("rebound")
-
-from validation import bench, report, sweeps  # noqa: E402
-from validation.problems import figure_eight, kepler, outer_solar_system  # noqa: E402
-from validation.settings import LEVELS  # noqa: E402
+from validation import bench, report, sweeps
+from validation.problems import figure_eight, kepler, outer_solar_system
+from validation.settings import LEVELS
 
 SMOKE = LEVELS["smoke"]
+
+
+@pytest.fixture
+def rebound():
+    """REBOUND, for the tests that run it (through validation's sweeps and bench): imported
+    here, not at module level, so that the others run without it."""
+    return pytest.importorskip("rebound")
 
 
 # -- the new methods in a sweep --------------------------------------------------------------------
@@ -27,7 +32,7 @@ def _sweep_all(problem, level=SMOKE):
     return sweeps.assemble_problem(problem, ref, results)
 
 
-def test_new_methods_are_swept_on_both_sides():
+def test_new_methods_are_swept_on_both_sides(rebound):
     entry = _sweep_all(kepler(0.6, t_end_orbits=2.0))
     methods = {r["method"] for r in entry["runs"]}
     for name in ("whfast", "whfast_c11", "whfast_c17", "saba", "sabac4", "ias15", "janus"):
@@ -58,7 +63,7 @@ def test_new_methods_are_swept_on_both_sides():
     assert row["ratio"] == pytest.approx(row["engine"]["time_s"] / row["rebound"]["time_s"])
 
 
-def test_whfast_and_saba_are_skipped_without_a_dominant_mass():
+def test_whfast_and_saba_are_skipped_without_a_dominant_mass(rebound):
     p = figure_eight(periods=1.0)
     ref = {"floor": 1e-12}  # never read: the methods are refused before any run
     for name in ("whfast", "whfast_c11", "saba", "sabac4"):
@@ -130,7 +135,7 @@ def test_versus_picks_the_fastest_run_of_each_code_that_reaches_the_level():
     assert report.ratio_cell(rows[1e-8]) == "0.50"
 
 
-def test_head_to_head_times_each_pair_once_and_keeps_the_sweep_ratio(monkeypatch):
+def test_head_to_head_times_each_pair_once_and_keeps_the_sweep_ratio(monkeypatch, rebound):
     p = kepler(0.6, t_end_orbits=1.0)
     p_key = "kepler_e0.6"
     runs = [_run("engine", "leapfrog", 1.0, 1e-3, setting=200),
@@ -155,7 +160,7 @@ def test_head_to_head_times_each_pair_once_and_keeps_the_sweep_ratio(monkeypatch
 
 # -- the bench rows -------------------------------------------------------------------------------
 
-def test_planet_bench_compares_the_same_computation():
+def test_planet_bench_compares_the_same_computation(rebound):
     r = bench.bench_planets(steps=200, span_days=2000.0, repeats=1)
     for key in ("whfast_c11", "ias15"):
         row = r["rows"][key]
