@@ -20,7 +20,7 @@ import numpy as np
 from engine import space
 from engine.batch import system_model
 from engine.cache import compiler
-from engine.forces import point_mass, thrust
+from engine.forces import dispatch, point_mass, thrust
 from engine.forces.calls import call_accumulate
 from engine.integrators import splitting
 from engine.state import Model, State, Workspace
@@ -392,27 +392,19 @@ def _forces(t, state, model, acc, work):
     and only a mode's other terms (``NBodyGravity``, ``Coulomb``) are called through their
     addresses. The same terms in the same order, so the same bits; a call through an address
     passes the whole state (about sixty words), which cost about 5% of a learning step."""
-    n = state.n
-    for k in range(acc.shape[0]):
-        for i in range(n):
-            acc[k, i] = 0.0
-    params = model.params
-    param_offsets = model.param_offsets
-    indices = model.indices
-    index_offsets = model.index_offsets
+    dispatch.clear(acc, state.n)
     for s in range(model.kinds.shape[0]):
         kind = model.kinds[s]
-        f0 = param_offsets[s]
-        f1 = param_offsets[s + 1]
-        i0 = index_offsets[s]
-        i1 = index_offsets[s + 1]
+        f0, f1 = model.param_offsets[s], model.param_offsets[s + 1]
+        i0, i1 = model.index_offsets[s], model.index_offsets[s + 1]
         if kind == point_mass.KIND:
-            point_mass.accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work)
+            point_mass.accumulate(t, state, model.params, f0, f1, model.indices, i0, i1, acc,
+                                  work)
         elif kind == thrust.KIND:
-            thrust.accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work)
+            thrust.accumulate(t, state, model.params, f0, f1, model.indices, i0, i1, acc, work)
         else:
-            call_accumulate(model.accumulators[s], t, state, params, f0, f1, indices, i0, i1,
-                            acc, work)
+            call_accumulate(model.accumulators[s], t, state, model.params, f0, f1,
+                            model.indices, i0, i1, acc, work)
 
 
 @jit(_nrt=False, inline="always")

@@ -170,6 +170,9 @@ class Window:
         self._limiter.tick(RENDER_CAP)
 
     def close(self):
+        # each font holds its file open until it is freed: a program that opens and closes
+        # windows would run out of file descriptors (a confined bot gets 64) with them kept
+        self.fonts = {}
         self.pygame.display.quit()
         self.pygame.font.quit()
 

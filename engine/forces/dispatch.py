@@ -34,15 +34,21 @@ def accelerations(t, state, model, acc, work):
 
 
 @jit(error_model="numpy", _nrt=False, inline="always")
+def clear(acc, n):
+    """``acc[:, :n] = 0`` as a loop (a slice in a caller's hot loop would cost reference
+    counting): what a force function does before its terms add to ``acc``."""
+    for k in range(acc.shape[0]):
+        for i in range(n):
+            acc[k, i] = 0.0
+
+
+@jit(error_model="numpy", _nrt=False, inline="always")
 def accelerations_inline(t, state, model, acc, work):
     """``accelerations``, inlined into its caller by numba (the loop over the terms; each
     term's kernel is called through its address). For executors that step many small
     systems: a call to a compiled function with a dozen array arguments (each passed as ten
     words) measured 25 to 165 ns, more than the forces on a few particles."""
-    n = state.n
-    for k in range(acc.shape[0]):
-        for i in range(n):
-            acc[k, i] = 0.0
+    clear(acc, state.n)
     params = model.params
     param_offsets = model.param_offsets
     indices = model.indices

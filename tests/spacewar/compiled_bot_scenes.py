@@ -360,7 +360,7 @@ def reached(branches, arcs):
 
 
 #: (scene, match, frame, seat): for each branch, the first state of the scenes taking it (the
-#: full run's ``--probes``, 12 matches of each scene; the scenes added for issue #31's open
+#: full run's ``--probes``, 12 matches of each scene; the scenes added for the last open
 #: branches, torpedo-no-star .. launch-at-star, measured on their own and merged in)
 PROBES = [
     ('at-star', 0, 0, 0), ('at-star', 0, 0, 1), ('at-star', 0, 1, 0), ('at-star', 0, 1, 1),
@@ -450,7 +450,7 @@ UNREACHABLE = {
     'predict_at+13:if:F':
         ('a Kepler point not finite, as predict_path+19 (never seen): kepler_step gave finite '
          'points for all 72,844 random starts tried (r 1e-20 to 1, speeds 1e-8 to 0.03, 30% '
-         'radial, t 1 to 95, mu 2.5e-7; measured on this machine for issue #31), radial orbits '
+         'radial, t 1 to 95, mu 2.5e-7; measured on this machine), radial orbits '
          'through the star included. The launch-at-star scene takes the other fallback (r = 0)'),
     'safest_heading+36:if:T':
         ('no burn direction within 0.9 of the best periapsis: needs a NaN periapsis. For a '

@@ -7,3 +7,17 @@ def replay_key(tmp_path_factory, monkeypatch):
     path = tmp_path_factory.getbasetemp() / "replay-key"
     monkeypatch.setenv("SPACEWAR_REPLAY_KEY_FILE", str(path))
     return path
+
+
+@pytest.fixture(scope="module")
+def gymnasium(optional):
+    """Gymnasium (an optional package: tests/conftest.py ``optional``)."""
+    return optional("gymnasium")
+
+
+@pytest.fixture(scope="module")
+def envs(gymnasium):
+    """spacewar.envs (importing it registers Spacewar-v0)."""
+    import spacewar.envs
+
+    return spacewar.envs

@@ -8,19 +8,6 @@ from spacewar.rules import Rules
 CAP = 40  # frames: episodes end by truncation, at a known step
 
 
-@pytest.fixture(scope="module")
-def gymnasium(optional):
-    return optional("gymnasium")
-
-
-@pytest.fixture(scope="module")
-def envs(gymnasium):
-    """spacewar.envs (importing it registers Spacewar-v0)."""
-    import spacewar.envs
-
-    return spacewar.envs
-
-
 def _lockstep(envs, mode, steps, num_envs=3, seed=11):
     """The same seeded run under next-step autoreset and under ``mode``, step by step."""
     ref = envs.SpacewarVectorEnv(num_envs, opponent="random", max_frames=CAP)

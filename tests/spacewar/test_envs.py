@@ -7,19 +7,6 @@ from spacewar.learning import learning_length
 from spacewar.rules import Rules
 
 
-@pytest.fixture(scope="module")
-def gymnasium(optional):
-    return optional("gymnasium")
-
-
-@pytest.fixture(scope="module")
-def envs(gymnasium):
-    """spacewar.envs (importing it registers Spacewar-v0)."""
-    import spacewar.envs
-
-    return spacewar.envs
-
-
 @pytest.mark.parametrize("opponent", ["idle", "random"])
 def test_the_env_passes_gymnasiums_checker(opponent, gymnasium, envs):
     from gymnasium.utils.env_checker import check_env
