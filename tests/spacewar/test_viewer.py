@@ -400,3 +400,30 @@ def test_keys_help_lists_every_viewer_key():
                  "Esc or Q"):
         assert keys in text
     assert K.speed_label(0.125) == "1/8x" and K.speed_label(8.0) == "8x"
+
+
+def _open_font_files():
+    """How many of this process's descriptors are open on a font file (Linux's /proc)."""
+    count = 0
+    for fd in os.listdir("/proc/self/fd"):
+        try:
+            count += os.readlink(f"/proc/self/fd/{fd}").endswith((".ttf", ".otf"))
+        except OSError:
+            pass
+    return count
+
+
+def test_a_closed_window_keeps_no_font_file_open(pygame):
+    """Each window's fonts held pygame's font file open after ``close``: a program opening
+    window after window ran out of descriptors (the test suite left 42 open, and a confined
+    bot host started after it got pipe numbers past its limit of 64)."""
+    from spacewar.viewer import Window
+
+    before = _open_font_files()
+    for _ in range(3):
+        window = Window(128, "fonts", ())
+        window.show([("text", 10.0, 10.0, "frame 1", (255, 255, 255), "left", 12.0),
+                     ("text", 10.0, 30.0, "frame 2", (255, 255, 255), "left", 20.0)])
+        assert _open_font_files() > before  # the control: a shown text opens the font file
+        window.close()
+        assert _open_font_files() == before
