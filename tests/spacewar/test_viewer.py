@@ -426,4 +426,4 @@ def test_a_closed_window_keeps_no_font_file_open(pygame):
                      ("text", 10.0, 30.0, "frame 2", (255, 255, 255), "left", 20.0)])
         assert _open_font_files() > before  # the control: a shown text opens the font file
         window.close()
-        assert _open_font_files() == before
+        assert _open_font_files() <= before  # (a font freed late elsewhere may lower it)
