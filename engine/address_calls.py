@@ -16,6 +16,8 @@ process that made them: they are never pickled or sent elsewhere.
 from numba import types
 from numba.core.errors import TypingError
 
+from .cache import jit_disabled
+
 #: the C-contiguous array types the functions called through addresses are compiled for
 F8_1D = types.Array(types.float64, 1, "C")
 F8_2D = types.Array(types.float64, 2, "C")
@@ -48,20 +50,22 @@ def call_at(context, builder, address, restype, wanted, given, args):
 
 #: with numba's JIT off (``NUMBA_DISABLE_JIT=1``: everything runs as the Python it is written
 #: in, for a debugger or a coverage tool), the functions an "address" stands for: its index here
-_PYTHON_FUNCTIONS = {}
+_PYTHON_FUNCTIONS = []
 
 
 def python_function(address):
     """With the JIT off, the Python function ``entry_address`` gave ``address`` for."""
-    return list(_PYTHON_FUNCTIONS)[address]
+    return _PYTHON_FUNCTIONS[address]
 
 
 def entry_address(dispatcher, signature):
     """Compile (or load from the cache) ``dispatcher`` for ``signature`` (a numba signature
     with its return type); the address of its compiled function. With the JIT off, the
     function's index for ``python_function``."""
-    if not hasattr(dispatcher, "overloads"):  # NUMBA_DISABLE_JIT=1: a plain function
-        return _PYTHON_FUNCTIONS.setdefault(dispatcher, len(_PYTHON_FUNCTIONS))
+    if jit_disabled():  # a plain function: its index
+        if dispatcher not in _PYTHON_FUNCTIONS:
+            _PYTHON_FUNCTIONS.append(dispatcher)
+        return _PYTHON_FUNCTIONS.index(dispatcher)
     compiled = dispatcher.overloads.get(signature.args)
     if compiled is None:
         dispatcher.compile(signature)

@@ -371,6 +371,14 @@ def _call_types(dispatcher, fixed=None):
     dispatcher.get_call_template = get_call_template
 
 
+def jit_disabled():
+    """Is numba's JIT off (``NUMBA_DISABLE_JIT=1``)? Then ``jit`` gives the plain Python
+    functions, and what would take their compiled code (addresses, entry points) takes them."""
+    from numba import config
+
+    return bool(config.DISABLE_JIT)
+
+
 def jit(signature=None, **options):
     """``numba.njit(cache=True, **options)`` with the dependency-keyed cache (module doc).
 
@@ -387,7 +395,7 @@ def jit(signature=None, **options):
 
     def decorate(function):
         dispatcher = numba.njit(cache=False, **options)(function)
-        if not hasattr(dispatcher, "py_func"):  # NUMBA_DISABLE_JIT=1: the function as written
+        if jit_disabled():  # the function as written
             return dispatcher
         dispatcher._cache = _cache_classes()(function)
         if options.get("inline", "never") == "never":

@@ -78,12 +78,12 @@ import math
 from fractions import Fraction
 
 import numpy as np
-from numba import config as numba_config, prange
+from numba import prange
 from numba.core import types
 from numba.extending import intrinsic
 
 from engine import space
-from engine.cache import numpy_dot_kind
+from engine.cache import jit_disabled, numpy_dot_kind
 from engine.analytic import kepler_step
 
 from . import core
@@ -140,7 +140,7 @@ def fma(typingctx, x, y, z):
     return sig, codegen
 
 
-if numba_config.DISABLE_JIT:  # the bots as plain Python (NUMBA_DISABLE_JIT=1, for tracing)
+if jit_disabled():  # the bots as plain Python (NUMBA_DISABLE_JIT=1, for tracing)
     def fma(x, y, z):  # noqa: F811 - an intrinsic cannot run in Python
         """``x y + z`` with one rounding: exact rationals, rounded once by int / int."""
         if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z)):

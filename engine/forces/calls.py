@@ -21,9 +21,10 @@ makes one from the terms, in the process that steps).
 import functools
 
 import numpy as np
-from numba import config, types
+from numba import types
 from numba.extending import intrinsic
 
+from ..cache import jit_disabled
 from ..address_calls import (F8_1D, F8_2D, I8_1D, call_at, check_call, entry_address,
                              python_function)
 
@@ -73,7 +74,7 @@ def call_potential(typingctx, address, t, state, params, f0, f1, indices, i0, i1
     return types.float64(address, *given), codegen
 
 
-if config.DISABLE_JIT:  # the kernels are plain functions (``entry_address``): call them so
+if jit_disabled():  # the kernels are plain functions (``entry_address``): call them so
     def call_accumulate(address, t, state, params, f0, f1, indices, i0, i1, acc,  # noqa: F811
                         work):
         python_function(address)(t, state, params, f0, f1, indices, i0, i1, acc, work)

@@ -16,6 +16,8 @@ and plans, with every scalar converted to float, int or bool before the call
 (``scalars``). Code of your own should call the dispatchers themselves.
 """
 
+from ..cache import jit_disabled
+
 _ENTRIES = {}
 #: verify every call's numba types against the fixed signature (slow: for tests)
 CHECK = False
@@ -29,7 +31,7 @@ def call(dispatcher, args):
             _check(dispatcher, args)
         return entry(*args)
     result = dispatcher(*args)
-    if not hasattr(dispatcher, "overloads"):  # NUMBA_DISABLE_JIT=1: a plain function
+    if jit_disabled():  # a plain function: nothing compiled to call directly
         return result
     signature = tuple(dispatcher.typeof_pyval(a) for a in args)
     compiled = dispatcher.overloads.get(signature)

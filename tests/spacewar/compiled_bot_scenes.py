@@ -495,7 +495,7 @@ def _replay(states_path, out_path):
     """Subprocess side: decide on every recorded state with the bots as plain Python, traced;
     check each decision is the recorded compiled one; write the arcs and, per arc, the first
     state reaching it."""
-    if not cb.numba_config.DISABLE_JIT:
+    if not cb.jit_disabled():
         raise SystemExit("run with NUMBA_DISABLE_JIT=1")
     data = np.load(states_path, allow_pickle=False)
     meta = json.loads(str(data["meta"]))
