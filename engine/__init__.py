@@ -9,7 +9,7 @@
     sim.step(7)
 """
 from . import analytic, atomic, cache, clock, diagnostics, forces, integrators, space, state
-from . import stability
+from . import initial_conditions, stability
 from .batch import Batch
 from .atomic import OutputPathError, atomic_write, check_output_dir, check_output_path
 from .clock import FixedStepClock
@@ -24,4 +24,4 @@ __version__ = "0.1.0"
 __all__ = ["Simulation", "Batch", "space", "state", "SimulationError", "INTEGRATORS", "ADAPTIVE_INTEGRATORS", "ORDERS", "SYMPLECTIC", "forces", "integrators",
            "analytic", "clock", "diagnostics", "stability", "FixedStepClock", "__version__", "atomic",
            "atomic_write", "check_output_path", "check_output_dir", "OutputPathError", "advise",
-           "advisor"]
+           "advisor", "initial_conditions"]

@@ -7,6 +7,10 @@ and its position error against the closed-form solution (``engine.analytic.keple
 ``python -m engine cloth [--out cloth.gif] [--frames N] ...``: a pinned cloth in the wind and a
 rope beside it, drawn to a GIF (``engine.cloth_demo``; needs the ``[viz]`` extra).
 
+``python -m engine galaxies [--out galaxies.gif] [--bodies N] [--frames F] ...``: two disk
+galaxies collide under tree gravity and raise tidal tails, drawn to a GIF
+(``engine.galaxies_demo``; needs the ``[viz]`` extra).
+
 ``python -m engine compile [--jobs N] [--list]``: compile the tour's integrators, every force
 kernel and ``Batch``'s executors ahead, one worker process per core (``engine.compile_ahead``).
 The tour itself compiles its integrators so on its first run.
@@ -17,7 +21,7 @@ import time
 
 import numpy as np
 
-from . import INTEGRATORS, Simulation, analytic, cloth_demo, compile_ahead, forces
+from . import INTEGRATORS, Simulation, analytic, cloth_demo, compile_ahead, forces, galaxies_demo
 from .integrators import FORCE_EVALUATIONS, ORDERS
 
 
@@ -56,19 +60,26 @@ def main(argv=None):
     parser.add_argument("--orbits", type=int, default=100)
     parser.add_argument("--evaluations", type=int, default=400,
                         help="force evaluations per orbit for the fixed-step methods")
-    commands = parser.add_subparsers(dest="command", metavar="{cloth,compile}",
-                                     help="cloth: the cloth-and-rope GIF demo; compile: the "
+    commands = parser.add_subparsers(dest="command", metavar="{cloth,galaxies,compile}",
+                                     help="cloth: the cloth-and-rope GIF demo; galaxies: two "
+                                          "colliding disk galaxies, to a GIF; compile: the "
                                           "tour's kernels compiled ahead, on every core "
                                           "(without a command: the Kepler tour)")
     cloth = commands.add_parser("cloth", help="a pinned cloth in the wind and a rope, to a GIF",
                                 description=cloth_demo.__doc__.split("\n\n")[0])
     cloth_demo.add_arguments(cloth)
+    galaxies = commands.add_parser("galaxies", help="two disk galaxies collide, to a GIF",
+                                   description=galaxies_demo.__doc__.split("\n\n")[0])
+    galaxies_demo.add_arguments(galaxies)
     ahead = commands.add_parser("compile", help="compile the engine's kernels ahead, on every core",
                                 description=compile_ahead.__doc__.split("\n\n")[0])
     compile_ahead.add_arguments(ahead)
     args = parser.parse_args(argv)
     if args.command == "cloth":
         cloth_demo.main(args, cloth)
+        return
+    if args.command == "galaxies":
+        galaxies_demo.main(args, galaxies)
         return
     if args.command == "compile":
         compile_ahead.main(args, compile_ahead.ENGINE)

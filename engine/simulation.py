@@ -13,7 +13,9 @@ from . import integrators as _integrators
 from ._validate import MAX_STEPS, finite_float, nonnegative_float, positive_float, real_array, step_count
 from .errors import SimulationError
 from .forces.base import DeclaresTerms
-from .forces.dispatch import pack, potential_terms
+from .forces import tree_terms
+from .forces.dispatch import accelerations as _accelerations, pack, potential_terms
+from .forces.pairwise import workspace as _pair_workspace
 from .integrators import direct
 from .integrators import ias15 as _ias15
 from .integrators import janus as _janus
@@ -96,6 +98,7 @@ class Simulation(DeclaresTerms):
         self._forces = []
         self._model = None
         self._model_key = None
+        self._work = None  # the tree's workspace, kept while the particle count allows
         self._velocity_dependent = False  # of the packed terms, found when they are packed
         self._plan = None  # whfast's and saba's plan of the scene, and what it was made from
         self._plan_key = None
@@ -407,13 +410,42 @@ class Simulation(DeclaresTerms):
 
     # -- forces ----------------------------------------------------------------------
     def _current_model(self):
-        key = (self._G, self._revision, *[f._version for f in self._forces])
+        # the particle count too: "auto" terms choose their method from it
+        key = (self._G, self._revision, self.n, *[f._version for f in self._forces])
         if key != self._model_key:
             self._model = pack(self._forces, self)
             # a term's velocity dependence follows its parameters, so it changes only with them
             self._velocity_dependent = any(f.velocity_dependent for f in self._forces)
             self._model_key = key
         return self._model
+
+    def _tree_terms(self):
+        """The declared terms that evaluate by the tree at this particle count."""
+        return [f for f in self._forces if tree_terms.uses_tree(f, self.n)]
+
+    def _workspace(self, state):
+        """The workspace a step passes to the force kernels: for a scene with tree terms, the
+        tree's (``engine.tree.layout``), made once and again only when the particle count
+        grows past it; otherwise None (each call makes the small one it needs)."""
+        if not self._tree_terms():
+            return None
+        from .tree import layout
+        if self._work is None or not layout.fits(state.n, self._work):
+            self._work = layout.workspace(max(state.n, 1))
+        return self._work
+
+    def accelerations(self):
+        """The accelerations the declared terms give at the current state and time: a new
+        ``(n, dim)`` array (code units); nothing is advanced. What a force model is checked
+        with (against a direct sum, a closed form, another code)."""
+        state, model = self.kernel_arguments()
+        self._check_state(state)
+        work = self._workspace(state)
+        if work is None:
+            work = _pair_workspace(state.n)
+        acc = np.zeros((self.dim, state.n))
+        _accelerations(self._t, state, model, acc, work)
+        return acc.T.copy()
 
     def parameter(self, term, name):
         """The packed values of ``term``'s float parameter ``name`` (a copy, shaped as the
@@ -490,6 +522,8 @@ class Simulation(DeclaresTerms):
                              "largest float (t would not be finite); nothing was changed")
         state, model = self.kernel_arguments()
         self._check_state(state)
+        tree_terms.check_integrator(self._forces, state.n, self._integrator)
+        work = self._workspace(state)
         plan = None
         if self._integrator in _integrators.KEPLER_SPLITTING:
             plan = self._kepler_plan(state, model)
@@ -505,7 +539,7 @@ class Simulation(DeclaresTerms):
         else:
             t, h_next, done, status = _integrators.advance(
                 self._integrator, self._t, h, steps, state, model, vdep, t_end,
-                self._tolerance, memory=memory, janus_order=self._janus_order,
+                self._tolerance, work=work, memory=memory, janus_order=self._janus_order,
                 lattice=lattice, counts=counts, direct=True)
         if self._integrator == "rk45":
             self.force_evaluations += int(counts[0])
@@ -633,10 +667,28 @@ class Simulation(DeclaresTerms):
         return diagnostics.kinetic_energy(p.vel, p.mass, self._moving(), p.n)
 
     def potential_energy_terms(self):
-        """Potential energy of each declared term, in declaration order."""
+        """Potential energy of each declared term, in declaration order.
+
+        A term that evaluates by the tree (``method="tree"``) sums its potential by the same
+        tree and ``theta`` (so it carries the tree's error; a direct sum over 10^6 bodies
+        would visit 10^12 pairs)."""
         state, model = self.kernel_arguments()
         out = np.zeros(len(self._forces))
-        potential_terms(self._t, state, model, out)
+        trees = self._tree_terms()
+        if not trees:
+            potential_terms(self._t, state, model, out)
+            return out
+        from .forces.registry import by_kind
+        work = self._workspace(state)
+        for s, term in enumerate(self._forces):
+            f0, f1 = int(model.param_offsets[s]), int(model.param_offsets[s + 1])
+            i0, i1 = int(model.index_offsets[s]), int(model.index_offsets[s + 1])
+            module = by_kind(int(model.kinds[s])).module
+            if any(term is tree for tree in trees):
+                out[s] = module.tree_potential(state, model.params, f0, work)
+            else:
+                out[s] = module.potential(self._t, state, model.params, f0, f1, model.indices,
+                                          i0, i1)
         return out
 
     def potential_energy(self):

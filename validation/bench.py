@@ -20,7 +20,11 @@ of the ratios is reported (with the median times). Sections:
    at 1 thread and at every thread;
 9. the planetary integrators on the outer solar system (Sun, four giants and Pluto): time per
    step of the engine's ``whfast`` with corrector 11 and of ``ias15`` (epsilon 1e-9) against
-   REBOUND's, side by side.
+   REBOUND's, side by side;
+10. tournaments and sweeps on Dask (``bench_cluster``);
+11. the Barnes-Hut tree (``NBodyGravity(method="tree")``) on a Plummer sphere against
+    pytreegrav's and REBOUND's trees at equal median force error, its scaling with N, its
+    crossover with the direct sum and its memory (``tree_bench``).
 """
 import argparse
 import json
@@ -795,7 +799,7 @@ def machine():
 
 def run(quick=False, sections=None):
     sections = sections or ["direct", "small", "scaling", "terms", "startup", "spacewar", "batch",
-                            "learning", "planets", "cluster"]
+                            "learning", "planets", "cluster", "tree"]
     repeats = 3 if quick else 7
     report = {"machine": machine(), "quick": quick}
     if "direct" in sections:
@@ -823,6 +827,11 @@ def run(quick=False, sections=None):
         from .bench_cluster import bench_cluster
 
         report["cluster"] = bench_cluster(quick)
+    if "tree" in sections:
+        from .tree_bench import SIZES, measure
+
+        report["tree"] = measure(SIZES["quick" if quick else "full"],
+                                 progress=lambda text: print(text, file=sys.stderr))
     return report
 
 
@@ -947,6 +956,10 @@ def targets(r):
                      "REBOUND's", f"{row['time_over_rebound']:.2f} of REBOUND's "
                      f"({row['engine_us_per_step']:.2f} us vs {row['rebound_us_per_step']:.2f} us)",
                      row["time_over_rebound"] <= 0.5))
+    if "tree" in r:
+        from .tree_bench import targets as tree_targets
+
+        rows += tree_targets(r["tree"])
     return rows
 
 
@@ -1081,6 +1094,11 @@ def format_report(r):
         lines.append("\n10. tournaments and sweeps on Dask (local processes against a "
                      "LocalCluster)")
         lines += format_cluster(r["cluster"])
+    if "tree" in r:
+        from .tree_bench import format_tree
+
+        lines.append("\n11. Barnes-Hut tree against pytreegrav and REBOUND at equal error")
+        lines += format_tree(r["tree"])
     if targets(r):
         lines.append("\ntargets:")
         for name, measured, met in targets(r):
@@ -1244,6 +1262,11 @@ def format_markdown(r, command):
 
         out += ["## 10. Tournaments and sweeps on Dask", ""] + markdown_cluster(r["cluster"])
         out.append("")
+    if "tree" in r:
+        from .tree_bench import markdown_tree
+
+        out += ["## 11. Barnes-Hut tree (`NBodyGravity(method=\"tree\")`)", ""]
+        out += markdown_tree(r["tree"]) + [""]
     return "\n".join(out)
 
 
@@ -1255,7 +1278,7 @@ def main(argv=None):
     parser.add_argument("--markdown", metavar="FILE", help="also write the results as Markdown")
     parser.add_argument("--only", metavar="SECTIONS",
                         help="comma-separated sections (default: every one): direct,small,"
-                             "scaling,terms,startup,spacewar,batch,learning,planets,cluster")
+                             "scaling,terms,startup,spacewar,batch,learning,planets,cluster,tree")
     args = parser.parse_args(argv)
     # a bad output path fails now, not after minutes of benchmarks
     try:

@@ -245,3 +245,68 @@ def spring_limits(limits, path):
     ax.legend(fontsize=8)
     ax.grid(True, axis="y", alpha=0.3)
     _save(fig, path)
+
+
+#: the tree section's codes: (colour, line style, marker)
+TREE_STYLE = {
+    "engine": ("tab:blue", "-", "o"),
+    "direct": ("tab:gray", ":", "s"),
+    "pytreegrav": ("tab:orange", "--", "^"),
+    "pytreegrav_quadrupole": ("tab:red", "--", "v"),
+    "rebound": ("black", "-.", "D"),
+}
+
+
+def tree_error(section, path):
+    """Median and 99th-percentile relative force error against theta, one line per code,
+    with the target error and each code's theta at it marked."""
+    fig, axes = plt.subplots(1, 2, figsize=(12.5, 4.6), layout="constrained")
+    target = section["target_error"]
+    for code, curve in section["error"]["curves"].items():
+        c, ls, mk = TREE_STYLE.get(code, ("tab:gray", "-", "."))
+        theta = [r["theta"] for r in curve["rows"]]
+        for ax, key in zip(axes, ("median", "p99")):
+            ax.loglog(theta, [max(r[key], 1e-17) for r in curve["rows"]], ls=ls, marker=mk,
+                      color=c, ms=4, label=section["labels"][code])
+        if curve["theta_at_target"] is not None:
+            axes[0].plot([curve["theta_at_target"]], [target], marker="*", ms=12, color=c,
+                         ls="none")
+    axes[0].axhline(target, color="gray", ls=":", lw=1)
+    for ax, what in zip(axes, ("median", "99th percentile")):
+        ax.set_xlabel("opening angle theta")
+        ax.set_ylabel(f"{what} of |a - a_exact| / |a_exact|")
+        ax.set_title(f"Plummer sphere, N = {section['error']['n']}: {what} error")
+        ax.grid(True, which="both", alpha=0.3)
+    axes[0].legend(fontsize=8)
+    _save(fig, path)
+
+
+def tree_time(section, path):
+    """Time of one force evaluation against N: the engine's tree (at its equal-error theta)
+    and direct sum, and each reference at its own equal-error theta."""
+    fig, ax = plt.subplots(figsize=(7.5, 5.0), layout="constrained")
+    lines = {}
+    s = section.get("scaling")
+    if s:
+        lines["engine"] = list(zip(s["n"], s["time_s"]))
+    c = section.get("crossover")
+    if c:
+        lines.setdefault("engine", [])
+        lines["engine"] += list(zip(c["n"], c["tree_s"]))
+        lines["direct"] = list(zip(c["n"], c["direct_s"]))
+    for row in section.get("compare", []):
+        for code, seconds in row["time_s"].items():
+            if code != "engine" or not s:
+                lines.setdefault(code, []).append((row["n"], seconds))
+    names = {**section["labels"], "direct": "engine direct sum"}
+    for code, points in lines.items():
+        points = sorted(dict(points).items())  # one point per N
+        colour, ls, mk = TREE_STYLE.get(code, ("tab:gray", "-", "."))
+        ax.loglog(*zip(*points), ls=ls, marker=mk, color=colour, ms=5, label=names.get(code, code))
+    ax.set_xlabel("N (Plummer sphere)")
+    ax.set_ylabel("seconds per force evaluation")
+    ax.set_title(f"one evaluation; trees at median error {section['target_error']:g}, "
+                 "direct sum exact")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    _save(fig, path)

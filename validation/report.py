@@ -2,10 +2,12 @@
 
 Writes ``DIR/report.md`` (tables, embedded plots, findings), the PNG plots and
 ``DIR/results.json`` (every figure in the report; deterministic except the keys named
-``time_s``, ``wall_s`` and the wall-time-based "fastest" entries).
+``time_s``, ``wall_s``, the wall-time-based "fastest" entries, and the tree section's times
+and speed-ups: its keys ending in ``_s``, ``speedup`` and ``repeats``).
 
 The untimed work (errors, energies, stability) runs on ``--workers`` processes; the timed
-work-precision sweeps then run one at a time in this process.
+work-precision sweeps then run one at a time in this process, and last the Barnes-Hut tree
+section (``tree_bench``: errors and times of the engine's tree, pytreegrav's and REBOUND's).
 """
 import argparse
 import json
@@ -20,13 +22,13 @@ import numpy as np
 import engine
 from engine.atomic import OutputPathError, atomic_write, check_output_dir, check_output_path
 
-from . import drift, hardcases, plots, sweeps, twobody
+from . import drift, hardcases, plots, sweeps, tree_bench, twobody
 from .jobs import Job, run_jobs
 from .problems import kepler, make_sim
 from .reference import rebound_version
 from .settings import LEVELS
 
-SECTIONS = ("crosscheck", "two_body", "energy_drift", "work_precision", "hard_cases")
+SECTIONS = ("crosscheck", "two_body", "energy_drift", "work_precision", "hard_cases", "tree")
 
 
 # -- running ---------------------------------------------------------------------------------------
@@ -94,8 +96,14 @@ def collect(level, workers=2, progress=True, sections=SECTIONS, scheduler=None):
         phase_b = time.perf_counter() - t_b
     if "hard_cases" in sections:
         out["hard_cases"] = hardcases.assemble(level, results)
+    phase_c = 0.0
+    if "tree" in sections:  # timed: alone in this process, after everything else
+        t_c = time.perf_counter()
+        say = (lambda text: print(f"tree: {text}", file=sys.stderr)) if progress else None
+        out["tree"] = tree_bench.measure(tree_bench.SIZES[level.name], progress=say)
+        phase_c = time.perf_counter() - t_c
     out["timings"] = {"wall_s": time.perf_counter() - t_start, "untimed_phase_wall_s": phase_a,
-                      "timed_phase_wall_s": phase_b}
+                      "timed_phase_wall_s": phase_b, "tree_phase_wall_s": phase_c}
     return out
 
 
@@ -944,6 +952,55 @@ def hard_findings(case, sec):
     return "**Findings.** " + " ".join(parts)
 
 
+def section_tree(sec, fig_error, fig_time):
+    """Section 6: the engine's Barnes-Hut tree against pytreegrav's and REBOUND's."""
+    lines = ["## 6. Barnes-Hut tree gravity: error and speed against pytreegrav and REBOUND", ""]
+    lines.append(
+        "`NBodyGravity(method=\"tree\", theta, order=2)` sums near pairs directly and far "
+        "cells by their multipoles to the quadrupole (Barnes & Hut 1986); pytreegrav and "
+        "REBOUND are the references (pytreegrav with its monopole and with its quadrupole "
+        "walk; REBOUND's pip build has the monopole tree on one core). The error of a body "
+        "is |a - a_exact| / |a_exact|, a_exact summing every other body exactly. The opening "
+        "angles of the three codes mean different things (the engine takes a cell whole when "
+        "its size is below theta times its distance from a leaf's group of targets; REBOUND "
+        "when its width is below theta times the distance from one target to the cell's "
+        "centre of mass; pytreegrav has a criterion of its own), so the codes are compared at "
+        "equal error, each at the theta its curve gives for a median error of "
+        f"{sec['target_error']:g}, not at equal theta.")
+    lines.append("")
+    lines.append(f"![relative force error against theta]({fig_error})")
+    lines.append("")
+    lines.append(f"![time of one force evaluation against N]({fig_time})")
+    lines.append("")
+    lines += tree_bench.markdown_tree(sec)
+    lines.append("")
+    lines.append(tree_findings(sec))
+    lines.append("")
+    return "\n".join(lines)
+
+
+def tree_findings(sec):
+    """The section's findings, from its figures (and its targets, met or not)."""
+    parts = []
+    curves = sec["error"]["curves"]
+    for code, curve in curves.items():
+        at = {round(r["theta"], 6): r for r in curve["rows"]}
+        if 0.5 in at:
+            parts.append(f"At theta = 0.5 the median error of {sec['labels'][code]} is "
+                         f"{f(at[0.5]['median'])} (99th percentile {f(at[0.5]['p99'])}).")
+    rows = [r for r in sec["compare"] if r.get("speedup")]
+    if rows:
+        big = rows[-1]
+        cells = ", ".join(f"{big['speedup'][c]:.1f}x against {sec['labels'][c]}"
+                          for c in big["speedup"])
+        parts.append(f"At N = {big['n']:.0e} and equal median error, the engine's tree's "
+                     f"speed-up (the other code's time over the engine's; below 1x the engine "
+                     f"is slower): {cells}.")
+    for name, measured, met in tree_bench.targets(sec):
+        parts.append(f"Target: {name}: {measured}, {'met' if met else 'not met'}.")
+    return "**Findings.** " + " ".join(parts)
+
+
 def section_glance(res, level):
     """The headline numbers, each taken from the sections below."""
     lines = ["## At a glance", ""]
@@ -1062,6 +1119,9 @@ def write(out_dir, res, level):
     if "hard_cases" in res:
         plots.spring_limits(res["hard_cases"]["spring_limits"],
                             os.path.join(out_dir, "spring_limits.png"))
+    if "tree" in res:
+        plots.tree_error(res["tree"], os.path.join(out_dir, "tree_error.png"))
+        plots.tree_time(res["tree"], os.path.join(out_dir, "tree_time.png"))
     atomic_write(os.path.join(out_dir, "results.json"), json.dumps(jsonable(res), indent=1) + "\n")
     atomic_write(os.path.join(out_dir, "report.md"), markdown(res, level, figs))
 
@@ -1076,6 +1136,9 @@ def output_files(sections=SECTIONS):
         files["energy_drift.png"] = "png"
     if "hard_cases" in sections:
         files["spring_limits.png"] = "png"
+    if "tree" in sections:
+        files["tree_error.png"] = "png"
+        files["tree_time.png"] = "png"
     return files
 
 
@@ -1100,7 +1163,8 @@ def markdown(res, level, figs):
         "in `results.json`.")
     parts.append("")
     parts.append("Contents: at a glance; 1. leapfrog cross-check with REBOUND; 2. two-body orbits; "
-                 "3. energy drift; 4. work-precision (choosing an integrator); 5. hard cases.")
+                 "3. energy drift; 4. work-precision (choosing an integrator); 5. hard cases; "
+                 "6. Barnes-Hut tree gravity.")
     parts.append("")
     parts.append(section_glance(res, level))
     if "crosscheck" in res:
@@ -1114,6 +1178,8 @@ def markdown(res, level, figs):
         parts.append(section_work_precision(res["work_precision"], figs))
     if "hard_cases" in res:
         parts.append(section_hard_cases(res["hard_cases"], "spring_limits.png"))
+    if "tree" in res:
+        parts.append(section_tree(res["tree"], "tree_error.png", "tree_time.png"))
     parts.append("## Reproducing")
     parts.append("")
     parts.append("```\npython -m validation report --out docs/validation          # this report\n"
@@ -1135,7 +1201,8 @@ def main(argv=None):
                     "its PNG plots and DIR/results.json.")
     parser.add_argument("--out", required=True, metavar="DIR", help="output directory")
     parser.add_argument("--quick", action="store_true",
-                        help="shorter runs and sweeps: one to two minutes on 2 cores")
+                        help="shorter runs and sweeps: one to two minutes on 2 cores, and "
+                             "a few more for the tree section (--only to leave it out)")
     parser.add_argument("--smoke", action="store_true", help=argparse.SUPPRESS)
     parser.add_argument("--workers", type=int, default=2,
                         help="processes for the untimed runs (default 2)")

@@ -81,6 +81,11 @@ class Force:
     def _check(self, sim):
         """Raise ValueError if this term cannot act in ``sim`` (dimension, indices)."""
 
+    def _kind(self, sim):
+        """The kind whose kernels act for this term in ``sim`` (a term with several methods,
+        such as ``NBodyGravity(method="tree")``, has one kind a method)."""
+        return self.KIND
+
     @property
     def velocity_dependent(self):
         """True if the acceleration depends on velocities (drag, damping)."""

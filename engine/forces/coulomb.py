@@ -12,7 +12,7 @@ import warnings
 
 from ..cache import jit
 
-from . import pairwise
+from . import pairwise, tree_terms
 from ._kernels import add_force, delta_periodic, pair_box
 from .base import Force, floats, EMPTY_INTS
 from .._validate import nonnegative_float, finite_float, optional, positive_float
@@ -75,17 +75,26 @@ class Coulomb(Force):
 
     ``box`` (deprecated): side of a periodic domain for this term alone; declare the space
     once instead (``Simulation(box=L)``), and pairs interact through their nearest image.
+
+    ``method``, ``theta``, ``order``: as ``NBodyGravity``'s (``"tree"``: the Barnes-Hut tree,
+    ``engine.forces.coulomb_tree``; charges of both signs, so the quadrupole ``order=2``, the
+    default, is what keeps a neutral plasma's error small).
     """
 
     KIND = KIND
-    LAYOUT = (("k", ()), ("softening_squared", ()), ("box", ()))
+    LAYOUT = (("k", ()), ("softening_squared", ()), ("box", ()), ("theta", ()), ("order", ()),
+              ("method", ()))
     BOUNDS = {"softening_squared": (0.0, False), "box": (0.0, False)}
     conservative = True
     _settable = {"k": finite_float, "softening": nonnegative_float,
-                 "box": optional(positive_float)}
+                 "box": optional(positive_float), "method": tree_terms.check_method,
+                 "theta": tree_terms.check_theta, "order": tree_terms.check_order}
 
-    def __init__(self, k=1.0, softening=0.0, box=None):
+    def __init__(self, k=1.0, softening=0.0, box=None, method="direct", theta=0.5, order=2):
         super().__init__()
+        self.method = method
+        self.theta = theta
+        self.order = order
         self.k = k
         self.softening = softening
         if box is not None:
@@ -95,10 +104,20 @@ class Coulomb(Force):
         self.box = box
 
     def _pack(self, sim):
-        return floats(self.k, self.softening ** 2, self.box or 0.0), EMPTY_INTS
+        return floats(self.k, self.softening ** 2, self.box or 0.0, *tree_terms.packed(self)), EMPTY_INTS
+
+    def _check(self, sim):
+        tree_terms.check_owner(self, sim)
+
+    def _kind(self, sim):
+        if tree_terms.uses_tree(self, sim.n):
+            from . import coulomb_tree
+            return coulomb_tree.KIND
+        return KIND
 
     def __repr__(self):
-        return f"Coulomb(k={self.k!r}, softening={self.softening!r})"
+        return (f"Coulomb(k={self.k!r}, softening={self.softening!r}, "
+                f"{tree_terms.describe(self)})")
 
 
 #: the term this module implements (for ``engine.forces.registry``)

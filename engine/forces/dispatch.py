@@ -119,7 +119,7 @@ def pack(terms, sim):
         params, indices = terms[0]._pack(sim)
         params = np.array(params, dtype=np.float64, order="C")
         indices = np.array(indices, dtype=np.int64, order="C")
-        layout = _layout((terms[0].KIND,), (0, params.shape[0]), (0, indices.shape[0]))
+        layout = _layout((terms[0]._kind(sim),), (0, params.shape[0]), (0, indices.shape[0]))
         return Model(layout[0], params, layout[1], indices, layout[2], layout[3], layout[4])
     param_blocks, index_blocks = [], []
     param_ends, index_ends = [0], [0]
@@ -133,7 +133,8 @@ def pack(terms, sim):
         # and for a few terms numpy's per-call cost would be most of the work
         param_ends.append(param_ends[-1] + params.shape[0])
         index_ends.append(index_ends[-1] + indices.shape[0])
-    layout = _layout(tuple(term.KIND for term in terms), tuple(param_ends), tuple(index_ends))
+    layout = _layout(tuple(term._kind(sim) for term in terms), tuple(param_ends),
+                     tuple(index_ends))
     params = np.concatenate(param_blocks)
     indices = np.concatenate(index_blocks)
     return Model(layout[0], params, layout[1], indices, layout[2], layout[3], layout[4])

@@ -16,7 +16,7 @@ import warnings
 
 from ..cache import jit
 
-from . import pairwise
+from . import pairwise, tree_terms
 from ._kernels import delta_periodic, nearest_image, pair_box
 from .base import Force, floats, EMPTY_INTS
 from .._validate import nonnegative_float, one_of, optional, positive_float
@@ -154,19 +154,34 @@ class NBodyGravity(Force):
     the system's extent are not resolved (such bodies coincide, and without softening the step
     raises SimulationError), and a scene of distant clumps loses accuracy in proportion.
     Positions, velocities, the small-N loop and the potential energy stay in float64.
+
+    ``method``: ``"direct"`` (the default) sums every pair, exactly; ``"tree"`` takes the
+    field from a Barnes-Hut tree with opening angle ``theta`` (in [0, 2); 0 sums every pair)
+    and multipoles to ``order`` (2: quadrupole) about each cell's centre, in O(N log N);
+    ``"auto"`` sums directly below ``tree_terms.DIRECT_BELOW`` particles and uses the tree
+    above (``engine.forces.tree_terms``, ``engine.forces.gravity_tree``: what it costs and
+    where it cannot act). The tree computes in float64 (``precision="float32"`` is the
+    direct sum's).
     """
 
     KIND = KIND
-    LAYOUT = (("G", ()), ("softening_squared", ()), ("box", ()), ("float32", ()))
+    LAYOUT = (("G", ()), ("softening_squared", ()), ("box", ()), ("float32", ()), ("theta", ()),
+              ("order", ()), ("method", ()))
     BOUNDS = {"G": (0.0, False), "softening_squared": (0.0, False), "box": (0.0, False)}
     conservative = True
 
     PRECISIONS = ("float64", "float32")
     _settable = {"G": optional(nonnegative_float), "softening": nonnegative_float,
-                 "box": optional(positive_float), "precision": one_of(*PRECISIONS)}
+                 "box": optional(positive_float), "precision": one_of(*PRECISIONS),
+                 "method": tree_terms.check_method, "theta": tree_terms.check_theta,
+                 "order": tree_terms.check_order}
 
-    def __init__(self, G=None, softening=0.0, box=None, precision="float64"):
+    def __init__(self, G=None, softening=0.0, box=None, precision="float64", method="direct",
+                 theta=0.5, order=2):
         super().__init__()
+        self.method = method
+        self.theta = theta
+        self.order = order
         self.G = G
         self.softening = softening
         if box is not None:
@@ -179,11 +194,28 @@ class NBodyGravity(Force):
     def _pack(self, sim):
         G = sim.G if self.G is None else self.G
         single = 1.0 if self.precision == "float32" else 0.0
-        return floats(G, self.softening ** 2, self.box or 0.0, single), EMPTY_INTS
+        return (floats(G, self.softening ** 2, self.box or 0.0, single, *tree_terms.packed(self)),
+                EMPTY_INTS)
+
+    def _check(self, sim):
+        tree_terms.check_owner(self, sim)
+        if self.method != "direct" and self.precision == "float32":
+            raise ValueError(f"NBodyGravity(method={self.method!r}) computes in float64: "
+                             "precision='float32' is the direct sum's; use one or the other")
+
+    def _kind(self, sim):
+        return gravity_tree_kind() if tree_terms.uses_tree(self, sim.n) else KIND
 
     def __repr__(self):
         return (f"NBodyGravity(G={self.G!r}, softening={self.softening!r}, box={self.box!r}, "
-                f"precision={self.precision!r})")
+                f"precision={self.precision!r}, {tree_terms.describe(self)})")
+
+
+def gravity_tree_kind():
+    """The kind of the tree's gravity kernels (``engine.forces.gravity_tree``; imported on
+    first use, so that a scene without a tree term loads none of the tree's code)."""
+    from . import gravity_tree
+    return gravity_tree.KIND
 
 
 #: the term this module implements (for ``engine.forces.registry``)

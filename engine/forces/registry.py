@@ -10,6 +10,8 @@ unique and reaching both, against the module's own kernels.
 """
 from collections import namedtuple
 
+import importlib
+
 from . import (blast, buoyancy, coulomb, drag, gravity, point_mass, springs, thrust,
                uniform_gravity, wind)
 
@@ -31,12 +33,29 @@ def entries():
     return tuple(out)
 
 
+#: modules that give a term of ``TERMS`` the kernels of another method, by kind: imported on
+#: first use, so that a scene without them loads none of their code (``NBodyGravity`` and
+#: ``Coulomb`` with ``method="tree"``: ``engine.tree``)
+METHODS = {10: "gravity_tree", 11: "coulomb_tree"}
+
+
+def method_entry(kind):
+    """The entry of a method's kind (``METHODS``): its module imported now."""
+    module = importlib.import_module(f"{__package__}.{METHODS[kind]}")
+    term = module.TERM
+    return Entry(module.KIND, f"{term.__name__}(method={module.METHOD!r})", term, module,
+                 term.conservative, term.LAYOUT, module.accumulate, module.potential,
+                 (module.__doc__ or "").strip())
+
+
 def by_kind(kind):
     """The entry of a kind number (KeyError naming it if none has it)."""
     for entry in entries():
         if entry.kind == kind:
             return entry
+    if kind in METHODS:
+        return method_entry(kind)
     raise KeyError(f"no force term has kind {kind!r}")
 
 
-__all__ = ["TERMS", "Entry", "entries", "by_kind"]
+__all__ = ["TERMS", "METHODS", "Entry", "entries", "method_entry", "by_kind"]

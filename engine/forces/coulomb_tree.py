@@ -1,0 +1,93 @@
+"""Coulomb's law by the Barnes-Hut tree: ``Coulomb(method="tree")`` (and "auto" above its
+threshold).
+
+The field of every active charged particle is taken from ``engine.tree`` (uncharged and
+inactive particles take no part, as in the direct sum), with alpha_i = -k q_i / m_i and
+beta_j = q_j:
+
+    a_i = -(k q_i / m_i) sum_j q_j (p_j - p_i) / (|p_j - p_i|^2 + eps^2)^(3/2)
+
+Charges of both signs cancel in a cell's total: a neutral cell acts through its dipole and
+quadrupole, which is why ``order=2`` (the default) is needed for a plasma (the error of a
+neutral plasma against theta is in docs/engine.md).
+
+summed directly for near pairs and by each far cell's multipoles about its centre (Barnes &
+Hut 1986, Nature 324, 446; Barnes 1990). The error falls with ``theta`` and is 0 to round-off
+at theta = 0 (every pair summed). Forces are not antisymmetric pair by pair, so total momentum
+drifts at the level of the force error (the direct sum keeps it to round-off).
+
+The potential energy of a simulation's tree term is summed by the same tree with the same
+theta: U = 1/2 sum_i k q_i sum_j q_j / r_ij (``Simulation.potential_energy``); the
+``potential`` kernel here, which has no workspace for a tree, sums every pair exactly.
+"""
+from ..cache import jit
+
+from ..tree import field, layout
+from . import coulomb, tree_terms
+
+KIND = 11
+
+
+@jit(error_model="numpy", inline="always")
+def _members(state, part, slots, k):
+    """List the active charged particles in ``slots`` with beta (q) in block 5 and alpha
+    (-k q / m) in block 6, by slot; how many."""
+    m = 0
+    for i in range(state.n):
+        q = state.charge[i]
+        if state.active[i] and q != 0.0:
+            slots[m] = i
+            m += 1
+            part[5, i] = q
+            part[6, i] = -k * q / state.mass[i]
+    return m
+
+
+@jit(error_model="numpy", inline="always")
+def _by_tree(m, params, f0):
+    """Does an evaluation of m particles take the tree ("auto": from its threshold on)?"""
+    return m > 0 and not (params[f0 + 5] == 2.0 and m < tree_terms.DIRECT_BELOW)
+
+
+@jit(error_model="numpy", _nrt=False)
+def accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work):
+    """acc += the tree's field; the direct sum without a tree workspace (a caller's own
+    ``pairwise.workspace``) or, for "auto", below the threshold."""
+    n = state.n
+    if layout.usable(n, work):
+        m = _members(state, field.blocks(work.floats, n), field.slots_of(work.ints, n),
+                     params[f0])
+        if _by_tree(m, params, f0):
+            field.solve(state.pos, n, m, work.floats, work.ints, params[f0 + 3],
+                        params[f0 + 1], int(params[f0 + 4]), False, work.threads)
+            field.scatter(acc, n, m, work.floats, work.ints)
+            return
+    coulomb.accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work)
+
+
+@jit(error_model="numpy", _nrt=False)
+def potential(t, state, params, f0, f1, indices, i0, i1):
+    """Every pair, exactly (the tree's potential needs a workspace: ``tree_potential``)."""
+    return coulomb.potential(t, state, params, f0, f1, indices, i0, i1)
+
+
+@jit(error_model="numpy")
+def tree_potential(state, params, f0, work):
+    """U = 1/2 sum_i k q_i phi_i, phi_i = sum_j q_j / r_ij from the tree (same theta)."""
+    n = state.n
+    part = field.blocks(work.floats, n)
+    slots = field.slots_of(work.ints, n)
+    m = _members(state, part, slots, params[f0])
+    if m == 0:
+        return 0.0
+    field.solve(state.pos, n, m, work.floats, work.ints, params[f0 + 3], params[f0 + 1],
+                int(params[f0 + 4]), True, work.threads)
+    u = 0.0
+    for k in range(m):
+        u += 0.5 * params[f0] * state.charge[slots[k]] * part[8, k]
+    return u
+
+
+#: the term whose method this module gives
+TERM = coulomb.Coulomb
+METHOD = "tree"

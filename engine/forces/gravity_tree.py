@@ -1,0 +1,90 @@
+"""Gravity by the Barnes-Hut tree: ``NBodyGravity(method="tree")`` (and "auto" above its
+threshold).
+
+The field of every active particle is taken from ``engine.tree`` (sources: the active
+particles that are not test particles and have mass; targets: every active particle), with
+alpha = 1 and beta_j = G m_j:
+
+    a_i = sum_j G m_j (p_j - p_i) / (|p_j - p_i|^2 + eps^2)^(3/2)
+
+summed directly for near pairs and by each far cell's multipoles about its centre (Barnes &
+Hut 1986, Nature 324, 446; Barnes 1990). The error falls with ``theta`` and is 0 to round-off
+at theta = 0 (every pair summed). Forces are not antisymmetric pair by pair, so total momentum
+drifts at the level of the force error (the direct sum keeps it to round-off).
+
+The potential energy of a simulation's tree term is summed by the same tree with the same
+theta: U = -1/2 sum_i m_i sum_j G m_j / r_ij (``Simulation.potential_energy``); the
+``potential`` kernel here, which has no workspace for a tree, sums every pair exactly.
+"""
+from ..cache import jit
+
+from ..tree import field, layout
+from . import gravity, tree_terms
+
+KIND = 10
+
+
+@jit(error_model="numpy", inline="always")
+def _members(state, part, slots, G):
+    """List the active particles in ``slots`` with beta (G m, 0 for a test particle) in
+    block 5 and alpha (1) in block 6, by slot; how many."""
+    m = 0
+    for i in range(state.n):
+        if state.active[i]:
+            slots[m] = i
+            m += 1
+            part[5, i] = 0.0 if state.test[i] else G * state.mass[i]
+            part[6, i] = 1.0
+    return m
+
+
+@jit(error_model="numpy", inline="always")
+def _by_tree(m, params, f0):
+    """Does an evaluation of m particles take the tree ("auto": from its threshold on)?"""
+    return m > 0 and not (params[f0 + 6] == 2.0 and m < tree_terms.DIRECT_BELOW)
+
+
+@jit(error_model="numpy", _nrt=False)
+def accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work):
+    """acc += the tree's field; the direct sum without a tree workspace (a caller's own
+    ``pairwise.workspace``) or, for "auto", below the threshold."""
+    n = state.n
+    if layout.usable(n, work):
+        m = _members(state, field.blocks(work.floats, n), field.slots_of(work.ints, n),
+                     params[f0])
+        if _by_tree(m, params, f0):
+            field.solve(state.pos, n, m, work.floats, work.ints, params[f0 + 4],
+                        params[f0 + 1], int(params[f0 + 5]), False, work.threads)
+            field.scatter(acc, n, m, work.floats, work.ints)
+            return
+    gravity.accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work)
+
+
+@jit(error_model="numpy", _nrt=False)
+def potential(t, state, params, f0, f1, indices, i0, i1):
+    """Every pair, exactly (the tree's potential needs a workspace: ``tree_potential``)."""
+    return gravity.potential(t, state, params, f0, f1, indices, i0, i1)
+
+
+@jit(error_model="numpy")
+def tree_potential(state, params, f0, work):
+    """U = -1/2 sum_i m_i phi_i, phi_i = sum_j G m_j / r_ij from the tree (same theta)."""
+    n = state.n
+    part = field.blocks(work.floats, n)
+    slots = field.slots_of(work.ints, n)
+    m = _members(state, part, slots, params[f0])
+    if m == 0:
+        return 0.0
+    field.solve(state.pos, n, m, work.floats, work.ints, params[f0 + 4], params[f0 + 1],
+                int(params[f0 + 5]), True, work.threads)
+    u = 0.0
+    for k in range(m):
+        i = slots[k]
+        if not state.test[i]:
+            u -= 0.5 * state.mass[i] * part[8, k]
+    return u
+
+
+#: the term whose method this module gives
+TERM = gravity.NBodyGravity
+METHOD = "tree"

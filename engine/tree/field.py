@@ -1,0 +1,97 @@
+"""One tree evaluation: sort, build, walk. What a tree force term calls every evaluation.
+
+The caller (``engine.forces.gravity_tree``, ``coulomb_tree``) lists the m particles that take
+part in ``slots`` (the workspace's ints block 1) and writes, by slot, each one's source weight
+beta into float block 5 and its target factor alpha into block 6; ``solve`` leaves, in key
+order, the slots (ints block 1), alpha (float block 4) and the field sum_j beta_j d / r^3 of
+every particle (float blocks 5 to 7; 8: the potential sum_j beta_j / r, when asked for).
+"""
+from ..cache import jit
+
+from . import build, layout, morton, walk
+
+#: most particles in a leaf (a leaf is also the group that shares one walk; the speed's
+#: optimum, measured on the bench's Plummer sphere at N = 10^6)
+LEAF_SIZE = 16
+#: most particles in a group, the targets that share one walk and its lists
+GROUP_SIZE = 64
+#: a cell taken whole of at most this many particles is summed particle by particle: as
+#: cheap as its expansion (a cell's interaction costs about 3.3 particles' on the development
+#: machine), and exact
+SMALL_CELL = 4
+#: from this many particles on the walk uses every core (below, starting the threads costs
+#: more than it saves)
+THREADS_MIN = 2048
+
+
+@jit(error_model="numpy", inline="always")
+def blocks(floats, n):
+    """The particle blocks: (PARTICLE_FLOATS, n) over the workspace's floats."""
+    return floats[:layout.PARTICLE_FLOATS * n].reshape((layout.PARTICLE_FLOATS, n))
+
+
+@jit(error_model="numpy", inline="always")
+def slots_of(ints, n):
+    return ints[n:2 * n]
+
+
+@jit(error_model="numpy")
+def solve(pos, n, m, floats, ints, theta, eps2, order, potential, threads,
+          leaf_size=LEAF_SIZE, group_size=GROUP_SIZE, small=SMALL_CELL):
+    """The field (and potential) of the m listed particles on each other (module doc)."""
+    dim = pos.shape[0]
+    keys = ints[0:n]
+    slots = ints[n:2 * n]
+    keys_tmp = ints[2 * n:3 * n]
+    slots_tmp = ints[3 * n:4 * n]
+    counts = ints[4 * n:4 * n + layout.RADIX + 1]
+    morton.keys(pos, slots, m, keys)
+    morton.sort(keys, slots, keys_tmp, slots_tmp, m, dim, counts)
+    part = blocks(floats, n)
+    for k in range(m):
+        i = slots[k]
+        part[0, k] = pos[0, i]
+        part[1, k] = pos[1, i]
+        part[2, k] = pos[2, i] if dim == 3 else 0.0
+        part[3, k] = part[5, i]
+        part[4, k] = part[6, i]
+    capacity = layout.cell_capacity(n)
+    base = layout.PARTICLE_FLOATS * n
+    cells = floats[base:base + layout.CELL_FLOATS * capacity].reshape((layout.CELL_FLOATS,
+                                                                      capacity))
+    cell_ints = ints[4 * n + layout.RADIX + 1:]
+    start = cell_ints[0:capacity]
+    count = cell_ints[capacity:2 * capacity]
+    child = cell_ints[2 * capacity:3 * capacity]
+    children = cell_ints[3 * capacity:4 * capacity]
+    groups = cell_ints[4 * capacity:5 * capacity]
+    stack = cell_ints[layout.CELL_INTS * capacity:layout.CELL_INTS * capacity + layout.STACK]
+    ncell = build.split(keys, m, dim, leaf_size, start, count, child, children, capacity)
+    while ncell < 0:  # a scene that needs more cells than the workspace has: larger leaves
+        leaf_size *= 2
+        ncell = build.split(keys, m, dim, leaf_size, start, count, child, children, capacity)
+    build.moments(part[0], part[1], part[2], part[3], start, count, child, children, cells,
+                  ncell)
+    ngroups = build.list_groups(count, child, children, group_size, groups, stack)
+    if threads and m >= THREADS_MIN:
+        walk.walk(floats, ints, n, ngroups, capacity, theta * theta, eps2, order, potential, small,
+                  layout.lanes(floats, ints, n))
+    else:
+        walk.walk_serial(floats, ints, n, ngroups, capacity, theta * theta, eps2, order,
+                         potential, small, 1)
+    return ncell
+
+
+@jit(error_model="numpy", inline="always")
+def scatter(acc, n, m, floats, ints):
+    """acc[:, slot] += alpha * field, for the m sorted particles ``solve`` left."""
+    part = blocks(floats, n)
+    slots = ints[n:2 * n]
+    dim = acc.shape[0]
+    for k in range(m):
+        i = slots[k]
+        a = part[4, k]
+        acc[0, i] += a * part[5, k]
+        acc[1, i] += a * part[6, k]
+        if dim == 3:
+            acc[2, i] += a * part[7, k]

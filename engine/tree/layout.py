@@ -1,0 +1,98 @@
+"""Where the tree keeps its scratch: blocks of one ``Workspace``'s float and int arrays.
+
+For n particle slots and C = ``cell_capacity(n)`` cells, the floats hold, in order:
+
+- ``PARTICLE_FLOATS`` blocks of n: the sorted particles' x, y, z, source weight beta, target
+  factor alpha, results ax, ay, az and the potential (summed only when asked for);
+- ``CELL_FLOATS`` blocks of C: each cell's centre (3), multipoles (13: weight, dipole,
+  quadrupole), size, radius, absolute weight and bounding box (6);
+- per thread, its interaction lists: ``LIST_PARTICLES`` particles (x, y, z, beta) and
+  ``LIST_CELLS`` cells (centre and multipoles);
+
+and the ints: the sort's keys and slots and their copies (4 blocks of n), the radix sort's
+counts, ``CELL_INTS`` blocks of C (first particle, count, first child, children, and the list
+of leaves) and each thread's stack.
+
+At 8 bytes a number that is 20 n floats and 6.5 n ints (C = n / 2): 212 bytes a particle,
+plus 156 KB per thread for its lists.
+"""
+import numpy as np
+from numba import config
+
+from ..cache import jit
+from ..state import Workspace
+
+#: per particle slot: x, y, z, beta, alpha, ax, ay, az, potential
+PARTICLE_FLOATS = 9
+#: per cell: centre 3, weight 1, dipole 3, quadrupole 6, size, radius, |weight|, box 6
+CELL_FLOATS = 22
+#: per cell: first sorted particle, particle count, first child, number of children; leaves
+CELL_INTS = 5
+#: the interaction lists of one thread: particles (x, y, z, beta each) and cells (13 each)
+LIST_PARTICLES = 2048
+LIST_CELLS = 1024
+LIST_FLOATS = 4 * LIST_PARTICLES + 13 * LIST_CELLS
+#: one thread's walk stack (a compressed tree of 64-bit keys is at most 31 levels deep, and
+#: a level pushes at most 8 cells)
+STACK = 512
+#: the radix sort's digit: 11 bits, so 63-bit keys sort in 6 passes
+RADIX_BITS = 11
+RADIX = 1 << RADIX_BITS
+#: threads a workspace made here has lists for (numba's largest thread count in this
+#: process); compiled code reads the count from the workspace itself (``lanes``), never from
+#: this value, which a cached function would keep from the process that compiled it
+THREADS = int(config.NUMBA_NUM_THREADS)
+
+
+@jit(error_model="numpy", inline="always")
+def cell_capacity(n):
+    """Cells a workspace for n particles holds: n / 2 + 64 (a leaf holds at least one
+    particle and, in a compressed tree, every other cell at least two children: at most 2n - 1
+    cells; the leaves hold many more than two particles in any scene of interest, and if a
+    scene needs more cells the build doubles the leaf size instead)."""
+    return n // 2 + 64
+
+
+@jit(error_model="numpy", inline="always")
+def float_count(n, threads):
+    return PARTICLE_FLOATS * n + CELL_FLOATS * cell_capacity(n) + threads * LIST_FLOATS
+
+
+@jit(error_model="numpy", inline="always")
+def int_count(n, threads):
+    return 4 * n + RADIX + 1 + CELL_INTS * cell_capacity(n) + threads * STACK
+
+
+@jit(error_model="numpy", inline="always")
+def lanes(floats, ints, n):
+    """How many threads' lists and stacks a workspace for n slots holds."""
+    by_floats = (floats.shape[0] - float_count(n, 0)) // LIST_FLOATS
+    by_ints = (ints.shape[0] - int_count(n, 0)) // STACK
+    return min(by_floats, by_ints)
+
+
+@jit(error_model="numpy", inline="always")
+def usable(n, work):
+    """Is ``work`` a tree workspace for n slots, with lists for one thread at least (else
+    the tree's callers sum directly)?"""
+    return lanes(work.floats, work.ints, n) >= 1
+
+
+def fits(n, work):
+    """Is ``work`` (from ``workspace``) large enough for n slots? (Python's ``usable``.)"""
+    return (work.floats.shape[0] >= float_count(n, THREADS)
+            and work.ints.shape[0] >= int_count(n, THREADS))
+
+
+def workspace(n, threads=True):
+    """A workspace for the tree and for the direct-sum kernels of ``engine.forces.pairwise``
+    (which use its first blocks), for n particle slots: made once per particle count by the
+    simulation that steps, never per step."""
+    n = max(int(n), 1)
+    return Workspace(np.empty(float_count(n, THREADS)), np.empty(int_count(n, THREADS),
+                                                                 dtype=np.int64), bool(threads))
+
+
+def bytes_per_particle(n):
+    """The workspace's bytes per particle slot at n slots (the per-thread lists included)."""
+    return 8 * (float_count(n, THREADS) + int_count(n, THREADS)) / n
