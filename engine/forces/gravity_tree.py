@@ -38,12 +38,6 @@ def _members(state, part, slots, G):
     return m
 
 
-@jit(error_model="numpy", inline="always")
-def _by_tree(m, params, f0):
-    """Does an evaluation of m particles take the tree ("auto": from its threshold on)?"""
-    return m > 0 and not (params[f0 + 6] == 2.0 and m < tree_terms.DIRECT_BELOW)
-
-
 @jit(error_model="numpy", _nrt=False)
 def accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work):
     """acc += the tree's field; the direct sum without a tree workspace (a caller's own
@@ -52,10 +46,9 @@ def accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work):
     if layout.usable(n, work):
         m = _members(state, field.blocks(work.floats, n), field.slots_of(work.ints, n),
                      params[f0])
-        if _by_tree(m, params, f0):
-            field.solve(state.pos, n, m, work.floats, work.ints, params[f0 + 4],
-                        params[f0 + 1], int(params[f0 + 5]), False, work.threads)
-            field.scatter(acc, n, m, work.floats, work.ints)
+        if field.add_field(state.pos, n, m, work.floats, work.ints, params[f0 + 4],
+                           params[f0 + 1], int(params[f0 + 5]), params[f0 + 6],
+                           tree_terms.DIRECT_BELOW, work.threads, acc):
             return
     gravity.accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work)
 

@@ -27,7 +27,7 @@ THREADS_MIN = 2048
 @jit(error_model="numpy", inline="always")
 def blocks(floats, n):
     """The particle blocks: (PARTICLE_FLOATS, n) over the workspace's floats."""
-    return floats[:layout.PARTICLE_FLOATS * n].reshape((layout.PARTICLE_FLOATS, n))
+    return layout.particle_blocks(floats, n)
 
 
 @jit(error_model="numpy", inline="always")
@@ -40,14 +40,10 @@ def solve(pos, n, m, floats, ints, theta, eps2, order, potential, threads,
           leaf_size=LEAF_SIZE, group_size=GROUP_SIZE, small=SMALL_CELL):
     """The field (and potential) of the m listed particles on each other (module doc)."""
     dim = pos.shape[0]
-    keys = ints[0:n]
-    slots = ints[n:2 * n]
-    keys_tmp = ints[2 * n:3 * n]
-    slots_tmp = ints[3 * n:4 * n]
-    counts = ints[4 * n:4 * n + layout.RADIX + 1]
+    keys, slots, keys_tmp, slots_tmp, counts = layout.sort_blocks(ints, n)
     morton.keys(pos, slots, m, keys)
     morton.sort(keys, slots, keys_tmp, slots_tmp, m, dim, counts)
-    part = blocks(floats, n)
+    part = layout.particle_blocks(floats, n)
     for k in range(m):
         i = slots[k]
         part[0, k] = pos[0, i]
@@ -56,16 +52,9 @@ def solve(pos, n, m, floats, ints, theta, eps2, order, potential, threads,
         part[3, k] = part[5, i]
         part[4, k] = part[6, i]
     capacity = layout.cell_capacity(n)
-    base = layout.PARTICLE_FLOATS * n
-    cells = floats[base:base + layout.CELL_FLOATS * capacity].reshape((layout.CELL_FLOATS,
-                                                                      capacity))
-    cell_ints = ints[4 * n + layout.RADIX + 1:]
-    start = cell_ints[0:capacity]
-    count = cell_ints[capacity:2 * capacity]
-    child = cell_ints[2 * capacity:3 * capacity]
-    children = cell_ints[3 * capacity:4 * capacity]
-    groups = cell_ints[4 * capacity:5 * capacity]
-    stack = cell_ints[layout.CELL_INTS * capacity:layout.CELL_INTS * capacity + layout.STACK]
+    cells = layout.cell_table(floats, n)
+    start, count, child, children, groups = layout.cell_links(ints, n)
+    stack = layout.lane_stack(ints, n, 0)
     ncell = build.split(keys, m, dim, leaf_size, start, count, child, children, capacity)
     while ncell < 0:  # a scene that needs more cells than the workspace has: larger leaves
         leaf_size *= 2
@@ -74,10 +63,10 @@ def solve(pos, n, m, floats, ints, theta, eps2, order, potential, threads,
                   ncell)
     ngroups = build.list_groups(count, child, children, group_size, groups, stack)
     if threads and m >= THREADS_MIN:
-        walk.walk(floats, ints, n, ngroups, capacity, theta * theta, eps2, order, potential, small,
+        walk.walk(floats, ints, n, ngroups, theta * theta, eps2, order, potential, small,
                   layout.lanes(floats, ints, n))
     else:
-        walk.walk_serial(floats, ints, n, ngroups, capacity, theta * theta, eps2, order,
+        walk.walk_serial(floats, ints, n, ngroups, theta * theta, eps2, order,
                          potential, small, 1)
     return ncell
 
@@ -85,8 +74,8 @@ def solve(pos, n, m, floats, ints, theta, eps2, order, potential, threads,
 @jit(error_model="numpy", inline="always")
 def scatter(acc, n, m, floats, ints):
     """acc[:, slot] += alpha * field, for the m sorted particles ``solve`` left."""
-    part = blocks(floats, n)
-    slots = ints[n:2 * n]
+    part = layout.particle_blocks(floats, n)
+    slots = slots_of(ints, n)
     dim = acc.shape[0]
     for k in range(m):
         i = slots[k]
@@ -95,3 +84,15 @@ def scatter(acc, n, m, floats, ints):
         acc[1, i] += a * part[6, k]
         if dim == 3:
             acc[2, i] += a * part[7, k]
+
+
+@jit(error_model="numpy", inline="always")
+def add_field(pos, n, m, floats, ints, theta, eps2, order, method, direct_below, threads, acc):
+    """acc += alpha * the tree's field of the m listed particles, and True; or False, acc
+    untouched, when the caller should sum directly instead (no particle, or ``method`` 2.0,
+    "auto", below ``direct_below`` particles)."""
+    if m == 0 or (method == 2.0 and m < direct_below):
+        return False
+    solve(pos, n, m, floats, ints, theta, eps2, order, False, threads)
+    scatter(acc, n, m, floats, ints)
+    return True

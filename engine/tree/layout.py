@@ -64,6 +64,56 @@ def int_count(n, threads):
 
 
 @jit(error_model="numpy", inline="always")
+def particle_blocks(floats, n):
+    """The particle blocks, (PARTICLE_FLOATS, n), at the start of the floats."""
+    return floats[:PARTICLE_FLOATS * n].reshape((PARTICLE_FLOATS, n))
+
+
+@jit(error_model="numpy", inline="always")
+def cell_table(floats, n):
+    """The cells' floats, (CELL_FLOATS, C): rows as ``multipoles`` names them."""
+    capacity = cell_capacity(n)
+    base = PARTICLE_FLOATS * n
+    return floats[base:base + CELL_FLOATS * capacity].reshape((CELL_FLOATS, capacity))
+
+
+@jit(error_model="numpy", inline="always")
+def sort_blocks(ints, n):
+    """The sort's keys, slots, their copies and the radix counts."""
+    return (ints[0:n], ints[n:2 * n], ints[2 * n:3 * n], ints[3 * n:4 * n],
+            ints[4 * n:4 * n + RADIX + 1])
+
+
+@jit(error_model="numpy", inline="always")
+def cell_links(ints, n):
+    """Each cell's first particle, count, first child and children, and the group list."""
+    capacity = cell_capacity(n)
+    base = 4 * n + RADIX + 1
+    return (ints[base:base + capacity], ints[base + capacity:base + 2 * capacity],
+            ints[base + 2 * capacity:base + 3 * capacity],
+            ints[base + 3 * capacity:base + 4 * capacity],
+            ints[base + 4 * capacity:base + 5 * capacity])
+
+
+@jit(error_model="numpy", inline="always")
+def lane_lists(floats, n, lane):
+    """Lane ``lane``'s particle list (x, y, z, beta) and cell list ((13, LIST_CELLS))."""
+    own = PARTICLE_FLOATS * n + CELL_FLOATS * cell_capacity(n) + lane * LIST_FLOATS
+    p = LIST_PARTICLES
+    cells = own + 4 * p
+    return (floats[own:own + p], floats[own + p:own + 2 * p], floats[own + 2 * p:own + 3 * p],
+            floats[own + 3 * p:own + 4 * p],
+            floats[cells:cells + 13 * LIST_CELLS].reshape((13, LIST_CELLS)))
+
+
+@jit(error_model="numpy", inline="always")
+def lane_stack(ints, n, lane):
+    """Lane ``lane``'s walk stack (lane 0's also serves the build)."""
+    own = int_count(n, 0) + lane * STACK
+    return ints[own:own + STACK]
+
+
+@jit(error_model="numpy", inline="always")
 def lanes(floats, ints, n):
     """How many threads' lists and stacks a workspace for n slots holds."""
     by_floats = (floats.shape[0] - float_count(n, 0)) // LIST_FLOATS

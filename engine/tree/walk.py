@@ -230,29 +230,13 @@ def walk_group(group, px, py, pz, beta, ax, ay, az, phi, cells, start, count, ch
 
 
 @jit(error_model="numpy")
-def walk_lane(lane, lanes, floats, ints, n, ngroups, capacity, theta2, eps2, order, potential,
-              small):
-    """The walks of leaves lane, lane + lanes, lane + 2 lanes, ... with lane's own lists."""
-    part = floats[:layout.PARTICLE_FLOATS * n].reshape((layout.PARTICLE_FLOATS, n))
-    base = layout.PARTICLE_FLOATS * n
-    cells = floats[base:base + layout.CELL_FLOATS * capacity].reshape((layout.CELL_FLOATS,
-                                                                      capacity))
-    cell_ints = ints[4 * n + layout.RADIX + 1:]
-    start = cell_ints[0:capacity]
-    count = cell_ints[capacity:2 * capacity]
-    child = cell_ints[2 * capacity:3 * capacity]
-    children = cell_ints[3 * capacity:4 * capacity]
-    groups = cell_ints[4 * capacity:5 * capacity]
-    own = base + layout.CELL_FLOATS * capacity + lane * layout.LIST_FLOATS
-    lx = floats[own:own + layout.LIST_PARTICLES]
-    ly = floats[own + layout.LIST_PARTICLES:own + 2 * layout.LIST_PARTICLES]
-    lz = floats[own + 2 * layout.LIST_PARTICLES:own + 3 * layout.LIST_PARTICLES]
-    lb = floats[own + 3 * layout.LIST_PARTICLES:own + 4 * layout.LIST_PARTICLES]
-    cstart = own + 4 * layout.LIST_PARTICLES
-    lc = floats[cstart:cstart + mp.MOMENTS * layout.LIST_CELLS].reshape(
-        (mp.MOMENTS, layout.LIST_CELLS))
-    stacks = 4 * n + layout.RADIX + 1 + layout.CELL_INTS * capacity
-    stack = ints[stacks + lane * layout.STACK:stacks + (lane + 1) * layout.STACK]
+def walk_lane(lane, lanes, floats, ints, n, ngroups, theta2, eps2, order, potential, small):
+    """The walks of groups lane, lane + lanes, lane + 2 lanes, ... with lane's own lists."""
+    part = layout.particle_blocks(floats, n)
+    cells = layout.cell_table(floats, n)
+    start, count, child, children, groups = layout.cell_links(ints, n)
+    lx, ly, lz, lb, lc = layout.lane_lists(floats, n, lane)
+    stack = layout.lane_stack(ints, n, lane)
     for g in range(lane, ngroups, lanes):
         walk_group(groups[g], part[0], part[1], part[2], part[3], part[5], part[6], part[7],
                   part[8], cells, start, count, child, children, lx, ly, lz, lb, lc, stack,
@@ -261,22 +245,21 @@ def walk_lane(lane, lanes, floats, ints, n, ngroups, capacity, theta2, eps2, ord
 
 #: one signature for both walks (see ``engine.forces.pairwise``: a parallel function is
 #: compiled once, for one signature, so that every cached caller links the same kernel)
-SIGNATURE = ("void(float64[::1], int64[::1], int64, int64, int64, float64, float64, int64, "
-             "boolean, int64, int64)")
+SIGNATURE = ("void(float64[::1], int64[::1], int64, int64, float64, float64, int64, boolean, "
+             "int64, int64)")
 
 
 @jit(signature=SIGNATURE, parallel=True, error_model="numpy")
-def walk(floats, ints, n, ngroups, capacity, theta2, eps2, order, potential, small, lanes):
+def walk(floats, ints, n, ngroups, theta2, eps2, order, potential, small, lanes):
     """Walk for every group, the groups dealt round-robin to ``lanes`` lanes (the workspace's
     lists: one a thread), since neighbours in key order cost about the same. Each group's
     result depends on nothing else: the same bits at any thread count."""
     for lane in prange(lanes):
-        walk_lane(lane, lanes, floats, ints, n, ngroups, capacity, theta2, eps2, order,
-                  potential, small)
+        walk_lane(lane, lanes, floats, ints, n, ngroups, theta2, eps2, order, potential,
+                  small)
 
 
 @jit(signature=SIGNATURE, error_model="numpy")
-def walk_serial(floats, ints, n, ngroups, capacity, theta2, eps2, order, potential, small,
-                lanes):
+def walk_serial(floats, ints, n, ngroups, theta2, eps2, order, potential, small, lanes):
     """``walk`` on the calling thread (few particles, or a caller that fills the cores)."""
-    walk_lane(0, 1, floats, ints, n, ngroups, capacity, theta2, eps2, order, potential, small)
+    walk_lane(0, 1, floats, ints, n, ngroups, theta2, eps2, order, potential, small)
