@@ -228,7 +228,16 @@ class Simulation(DeclaresTerms):
 
     @box.setter
     def box(self, value):
-        self._box = check_box(self._code(value, "length", "box"))
+        box = check_box(self._code(value, "length", "box"))
+        old = self._box
+        self._box = box
+        try:
+            for term in self._forces:  # a term that cannot act in the new space refuses it
+                term._check(self)
+        except ValueError:
+            self._box = old
+            raise
+        self._revision += 1
 
     @property
     def units(self):

@@ -398,14 +398,18 @@ class Game:
         """Match m's force parameters as the state hash has always covered them, so replays
         recorded before the game ran on ``engine.Batch`` still verify: each term's packed
         floats, with the torus side in the pair terms' box entry (the batch's space now holds
-        it)."""
+        it), and without the parameters of the pair terms' tree method."""
         row = self.model.params[m]
         offsets = self.model.param_offsets
         parts = []
         for k, term in enumerate(self.terms):
             block = row[offsets[k]:offsets[k + 1]].copy()
             if isinstance(term, (forces.NBodyGravity, forces.Coulomb)):
-                block[term.layout(self.batch)["box"][0]] = self.batch.box
+                layout = term.layout(self.batch)
+                block[layout["box"][0]] = self.batch.box
+                # the tree's parameters (theta, order, method) came later, and a batch's terms
+                # sum directly: hashed without them, as before
+                block = block[:layout["theta"][0]]
             parts.append(block)
         return np.concatenate(parts)
 

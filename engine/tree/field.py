@@ -10,8 +10,8 @@ from ..cache import jit
 
 from . import build, layout, morton, walk
 
-#: most particles in a leaf (a leaf is also the group that shares one walk; the speed's
-#: optimum, measured on the bench's Plummer sphere at N = 10^6)
+#: most particles in a leaf (except particles at one point: ``build.split``); 8 to 64 cost
+#: the same to 10% on the bench's Plummer sphere at N = 10^5, with groups of 16 to 128
 LEAF_SIZE = 16
 #: most particles in a group, the targets that share one walk and its lists
 GROUP_SIZE = 64
@@ -41,24 +41,21 @@ def solve(pos, n, m, floats, ints, theta, eps2, order, potential, threads,
     """The field (and potential) of the m listed particles on each other (module doc)."""
     dim = pos.shape[0]
     keys, slots, keys_tmp, slots_tmp, counts = layout.sort_blocks(ints, n)
-    morton.keys(pos, slots, m, keys)
-    morton.sort(keys, slots, keys_tmp, slots_tmp, m, dim, counts)
     part = layout.particle_blocks(floats, n)
-    for k in range(m):
-        i = slots[k]
-        part[0, k] = pos[0, i]
-        part[1, k] = pos[1, i]
-        part[2, k] = pos[2, i] if dim == 3 else 0.0
-        part[3, k] = part[5, i]
-        part[4, k] = part[6, i]
-    capacity = layout.cell_capacity(n)
     cells = layout.cell_table(floats, n)
     start, count, child, children, groups = layout.cell_links(ints, n)
     stack = layout.lane_stack(ints, n, 0)
-    ncell = build.split(keys, m, dim, leaf_size, start, count, child, children, capacity)
-    while ncell < 0:  # a scene that needs more cells than the workspace has: larger leaves
+    capacity = layout.cell_capacity(n)
+    ncell = -1
+    while ncell < 0:
+        # from the top each time: a failed split may have keyed some ranges again
+        morton.keys(pos, slots, m, keys)
+        morton.sort(keys, slots, keys_tmp, slots_tmp, m, dim, counts)
+        build.gather(pos, part, slots, 0, m)
+        ncell = build.split(keys, slots, keys_tmp, slots_tmp, counts, pos, part, m, dim,
+                            leaf_size, start, count, child, children, capacity)
+        # a scene that needs more cells than the workspace has: larger leaves
         leaf_size *= 2
-        ncell = build.split(keys, m, dim, leaf_size, start, count, child, children, capacity)
     build.moments(part[0], part[1], part[2], part[3], start, count, child, children, cells,
                   ncell)
     ngroups = build.list_groups(count, child, children, group_size, groups, stack)
@@ -80,6 +77,8 @@ def scatter(acc, n, m, floats, ints):
     for k in range(m):
         i = slots[k]
         a = part[4, k]
+        if part[5, k] == 0.0 and part[6, k] == 0.0 and part[7, k] == 0.0:
+            continue  # as the direct sum skips a zero force: a massless particle stays finite
         acc[0, i] += a * part[5, k]
         acc[1, i] += a * part[6, k]
         if dim == 3:
@@ -87,11 +86,10 @@ def scatter(acc, n, m, floats, ints):
 
 
 @jit(error_model="numpy", inline="always")
-def add_field(pos, n, m, floats, ints, theta, eps2, order, method, direct_below, threads, acc):
-    """acc += alpha * the tree's field of the m listed particles, and True; or False, acc
-    untouched, when the caller should sum directly instead (no particle, or ``method`` 2.0,
-    "auto", below ``direct_below`` particles)."""
-    if m == 0 or (method == 2.0 and m < direct_below):
+def add_field(pos, n, m, floats, ints, theta, eps2, order, threads, acc):
+    """acc += alpha * the tree's field of the m listed particles, and True; False (acc
+    untouched) when there are none."""
+    if m == 0:
         return False
     solve(pos, n, m, floats, ints, theta, eps2, order, False, threads)
     scatter(acc, n, m, floats, ints)

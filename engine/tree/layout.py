@@ -6,15 +6,16 @@ For n particle slots and C = ``cell_capacity(n)`` cells, the floats hold, in ord
   factor alpha, results ax, ay, az and the potential (summed only when asked for);
 - ``CELL_FLOATS`` blocks of C: each cell's centre (3), multipoles (13: weight, dipole,
   quadrupole), size, radius, absolute weight and bounding box (6);
-- per thread, its interaction lists: ``LIST_PARTICLES`` particles (x, y, z, beta) and
-  ``LIST_CELLS`` cells (centre and multipoles);
+- per thread, its interaction lists: ``LIST_PARTICLES`` particles (x, y, z, beta), twice
+  ``LIST_CELLS`` cells (centre and multipoles: summed at each target, or into the group's
+  local expansion) and the local expansion (``LOCAL``);
 
 and the ints: the sort's keys and slots and their copies (4 blocks of n), the radix sort's
 counts, ``CELL_INTS`` blocks of C (first particle, count, first child, children, and the list
 of leaves) and each thread's stack.
 
 At 8 bytes a number that is 20 n floats and 6.5 n ints (C = n / 2): 212 bytes a particle,
-plus 156 KB per thread for its lists.
+plus 279 KB per thread for its lists.
 """
 import numpy as np
 from numba import config
@@ -31,7 +32,9 @@ CELL_INTS = 5
 #: the interaction lists of one thread: particles (x, y, z, beta each) and cells (13 each)
 LIST_PARTICLES = 2048
 LIST_CELLS = 1024
-LIST_FLOATS = 4 * LIST_PARTICLES + 13 * LIST_CELLS
+#: a group's local expansion: field (3), gradient (6), second derivatives (10), potential (10)
+LOCAL = 32
+LIST_FLOATS = 4 * LIST_PARTICLES + 2 * 13 * LIST_CELLS + LOCAL
 #: one thread's walk stack (a compressed tree of 64-bit keys is at most 31 levels deep, and
 #: a level pushes at most 8 cells)
 STACK = 512
@@ -97,13 +100,18 @@ def cell_links(ints, n):
 
 @jit(error_model="numpy", inline="always")
 def lane_lists(floats, n, lane):
-    """Lane ``lane``'s particle list (x, y, z, beta) and cell list ((13, LIST_CELLS))."""
+    """Lane ``lane``'s particle list (x, y, z, beta), its two cell lists ((13, LIST_CELLS):
+    cells summed at each target, cells summed into the local expansion) and the expansion."""
     own = PARTICLE_FLOATS * n + CELL_FLOATS * cell_capacity(n) + lane * LIST_FLOATS
     p = LIST_PARTICLES
     cells = own + 4 * p
+    far = cells + 13 * LIST_CELLS
+    local = far + 13 * LIST_CELLS
     return (floats[own:own + p], floats[own + p:own + 2 * p], floats[own + 2 * p:own + 3 * p],
             floats[own + 3 * p:own + 4 * p],
-            floats[cells:cells + 13 * LIST_CELLS].reshape((13, LIST_CELLS)))
+            floats[cells:cells + 13 * LIST_CELLS].reshape((13, LIST_CELLS)),
+            floats[far:far + 13 * LIST_CELLS].reshape((13, LIST_CELLS)),
+            floats[local:local + LOCAL])
 
 
 @jit(error_model="numpy", inline="always")

@@ -45,13 +45,14 @@ def spread2(v):
 @jit(error_model="numpy", inline="always")
 def cell_index(x, lo, scale, top):
     """The integer coordinate of x in [lo, lo + side): floor((x - lo) scale), clipped to
-    [0, top] (scale = 2^bits / side; the clip keeps the cube's far face inside)."""
-    u = int((x - lo) * scale)
-    if u < 0:
+    [0, top] (scale = 2^bits / side; the clip keeps the cube's far face inside), clipped as a
+    float first, so that no infinite or NaN value is ever converted to an integer."""
+    f = (x - lo) * scale
+    if not f > 0.0:
         return 0
-    if u > top:
+    if f >= top:
         return top
-    return u
+    return int(f)
 
 
 @jit(error_model="numpy", inline="always")
@@ -98,6 +99,37 @@ def keys(pos, slots, m, out):
             i = slots[k]
             out[k] = (spread2(cell_index(pos[0, i], lx, scale, top))
                       | (spread2(cell_index(pos[1, i], ly, scale, top)) << 1))
+
+
+@jit(error_model="numpy", inline="always")
+def range_keys(px, py, pz, s, e, dim, out):
+    """out[k] = the key of sorted particle k in [s, e), in the bounding cube of those
+    particles alone; False (nothing written) if they all coincide."""
+    lx = hx = px[s]
+    ly = hy = py[s]
+    lz = hz = pz[s]
+    for k in range(s + 1, e):
+        lx = min(lx, px[k])
+        hx = max(hx, px[k])
+        ly = min(ly, py[k])
+        hy = max(hy, py[k])
+        lz = min(lz, pz[k])
+        hz = max(hz, pz[k])
+    side = max(hx - lx, hy - ly, hz - lz)
+    if not side > 0.0:
+        return False
+    bits = bits_per_axis(dim)
+    top = (1 << bits) - 1
+    scale = (1 << bits) / side
+    for k in range(s, e):
+        if dim == 3:
+            out[k] = (spread3(cell_index(px[k], lx, scale, top))
+                      | (spread3(cell_index(py[k], ly, scale, top)) << 1)
+                      | (spread3(cell_index(pz[k], lz, scale, top)) << 2))
+        else:
+            out[k] = (spread2(cell_index(px[k], lx, scale, top))
+                      | (spread2(cell_index(py[k], ly, scale, top)) << 1))
+    return True
 
 
 @jit(error_model="numpy", inline="always")
