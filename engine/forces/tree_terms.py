@@ -20,8 +20,8 @@ METHOD_CODES = {"direct": 0.0, "tree": 1.0, "auto": 2.0}
 #: the multipole orders the tree offers (``engine.tree.multipoles``)
 ORDERS = (0, 1, 2)
 #: ``method="auto"`` sums directly below this many interacting particles: about where the
-#: tree at median force error 1e-3 overtakes the direct sum (1351 bodies on the 2-core AMD
-#: EPYC of docs/performance.md, Plummer sphere, both cores; ``python -m validation bench``,
+#: tree at median force error 1e-3 overtakes the direct sum (1241 and 1351 bodies in two runs
+#: on the 2-core AMD EPYC of docs/performance.md, Plummer sphere, both cores; ``python -m validation bench``,
 #: section "tree"). A constant, the same on every machine, so that results do not depend on
 #: where they run
 DIRECT_BELOW = 1500
