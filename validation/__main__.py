@@ -1,13 +1,14 @@
 """``python -m validation report --out DIR [--quick]`` | ``python -m validation bench ...`` |
 ``python -m validation advise --problem NAME --error E [--t-end T]`` |
-``python -m validation compile-times -- COMMAND ...``"""
+``python -m validation compile-times -- COMMAND ...`` | ``python -m validation theta-table
+[--n N]``"""
 import argparse
 import importlib
 import sys
 
 #: the modules each command needs beyond the core install, and the extra that has them
 NEEDS = {"report": ("rebound", "matplotlib"), "bench": ("rebound",), "advise": (),
-         "compile-times": ()}
+         "compile-times": (), "theta-table": ()}
 EXTRA = "validation"
 #: the bench sections that time REBOUND side by side (the others run without it)
 BENCH_REBOUND_SECTIONS = frozenset({"direct", "small", "planets"})
@@ -50,7 +51,8 @@ def main(argv=None):
     parser = argparse.ArgumentParser(
         prog="python -m validation",
         description="Validation of the engine against REBOUND and closed forms, and benchmarks.")
-    sub = parser.add_subparsers(dest="command", metavar="{report,bench,advise,compile-times}")
+    sub = parser.add_subparsers(dest="command",
+                                metavar="{report,bench,advise,compile-times,theta-table}")
     sub.add_parser("report", add_help=False,
                    help="orbits, energy drift, work-precision and hard cases: DIR/report.md")
     sub.add_parser("bench", add_help=False, help="benchmarks")
@@ -59,6 +61,8 @@ def main(argv=None):
                         "(engine.advise)")
     sub.add_parser("compile-times", add_help=False,
                    help="what a command compiles from an empty cache, function by function")
+    sub.add_parser("theta-table", add_help=False,
+                   help="the tree's theta against error and cost (docs/engine.md)")
     if not argv or argv[0] not in NEEDS:
         parser.parse_args(argv)  # prints usage / help, or the error for an unknown command
         parser.print_help()
@@ -77,6 +81,9 @@ def main(argv=None):
     if command == "compile-times":
         from . import compile_times
         return compile_times.main(rest)
+    if command == "theta-table":
+        from . import theta_table
+        return theta_table.main(rest)
     from . import bench  # written separately; imported only when asked for
     return bench.main(rest)
 

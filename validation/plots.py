@@ -250,6 +250,7 @@ def spring_limits(limits, path):
 #: the tree section's codes: (colour, line style, marker)
 TREE_STYLE = {
     "engine": ("tab:blue", "-", "o"),
+    "engine_tree": ("tab:cyan", "-", "x"),
     "direct": ("tab:gray", ":", "s"),
     "pytreegrav": ("tab:orange", "--", "^"),
     "pytreegrav_quadrupole": ("tab:red", "--", "v"),
@@ -282,8 +283,9 @@ def tree_error(section, path):
 
 
 def tree_time(section, path):
-    """Time of one force evaluation against N: the engine's tree (at its equal-error theta)
-    and direct sum, and each reference at its own equal-error theta."""
+    """Time of one force evaluation against N: the engine's FMM (at its equal-error theta)
+    and direct sum, and its Barnes-Hut walk and each reference at their own equal-error
+    thetas."""
     fig, ax = plt.subplots(figsize=(7.5, 5.0), layout="constrained")
     lines = {}
     s = section.get("scaling")

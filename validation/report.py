@@ -953,11 +953,16 @@ def hard_findings(case, sec):
 
 
 def section_tree(sec, fig_error, fig_time):
-    """Section 6: the engine's Barnes-Hut tree against pytreegrav's and REBOUND's."""
-    lines = ["## 6. Barnes-Hut tree gravity: error and speed against pytreegrav and REBOUND", ""]
+    """Section 6: the engine's tree gravity (FMM and Barnes-Hut) against pytreegrav's and
+    REBOUND's trees."""
+    lines = ["## 6. Tree gravity: error and speed against pytreegrav and REBOUND", ""]
     lines.append(
         "`NBodyGravity(method=\"tree\", theta, order=2)` sums near pairs directly and far "
-        "cells by their multipoles to the quadrupole (Barnes & Hut 1986); pytreegrav and "
+        "cells by their multipoles to the quadrupole (Barnes & Hut 1986), walking the tree "
+        "from its root for every group of targets; `method=\"fmm\"` (what `\"auto\"` uses) "
+        "walks the same tree once, cells acting on cells through local expansions passed "
+        "down to the groups (a fast multipole method: Greengard & Rokhlin 1987, Dehnen "
+        "2002), so that its cost grows as N rather than N log N; pytreegrav and "
         "REBOUND are the references (pytreegrav with its monopole and with its quadrupole "
         "walk; REBOUND's pip build has the monopole tree on one core). The error of a body "
         "is |a - a_exact| / |a_exact|, a_exact summing every other body exactly. The opening "
@@ -993,7 +998,7 @@ def tree_findings(sec):
         big = rows[-1]
         cells = ", ".join(f"{big['speedup'][c]:.1f}x against {sec['labels'][c]}"
                           for c in big["speedup"])
-        parts.append(f"At N = {big['n']:.0e} and equal median error, the engine's tree's "
+        parts.append(f"At N = {big['n']:.0e} and equal median error, the engine FMM's "
                      f"speed-up (the other code's time over the engine's; below 1x the engine "
                      f"is slower): {cells}.")
     for name, measured, met in tree_bench.targets(sec):
@@ -1164,7 +1169,7 @@ def markdown(res, level, figs):
     parts.append("")
     parts.append("Contents: at a glance; 1. leapfrog cross-check with REBOUND; 2. two-body orbits; "
                  "3. energy drift; 4. work-precision (choosing an integrator); 5. hard cases; "
-                 "6. Barnes-Hut tree gravity.")
+                 "6. Tree gravity (FMM and Barnes-Hut).")
     parts.append("")
     parts.append(section_glance(res, level))
     if "crosscheck" in res:

@@ -1,6 +1,8 @@
 """The tree section of ``python -m validation bench`` (and of the validation report): the
-engine's Barnes-Hut gravity (``NBodyGravity(method="tree")``) against pytreegrav's and
-REBOUND's trees, measured side by side in one run.
+engine's tree gravity, by its fast multipole walk (``NBodyGravity(method="fmm")``, what
+``method="auto"`` uses: the code named "engine" here) and by its Barnes-Hut walk
+(``method="tree"``: "engine_tree"), against pytreegrav's and REBOUND's trees, measured side
+by side in one run.
 
 The scene: a Plummer (1911) sphere of total mass 1 and scale radius 1 (G = 1, 3-D, float64;
 ``engine.initial_conditions.plummer``, sampled as Aarseth, Henon & Wielen 1974), Plummer
@@ -19,12 +21,14 @@ softening eps = 1e-3, every thread numba has.
   exact fields differ by 1e-5 at the median body of a 5000-body sphere): the two kernels
   give the same forces, well below the errors compared.
 - **Equal error.** For each code the theta at which the median error is ``TARGET_ERROR``
-  (``theta_for_error``: log-log interpolation on the error-against-theta curve), and the time of
-  one force evaluation at that theta at each N, the codes timed one after the other in each
-  repetition and the median of the per-repetition ratios kept. The median error of each
-  code at each timed N is measured on the evaluation itself, to show the match holds there.
+  (``theta_for_error``: log-log interpolation on the error-against-theta curve at
+  ``error_n``), then at each timed N the theta for that error on that very scene
+  (``tuned_theta``: a curve of three or more thetas around it), and the time of one force
+  evaluation there, the codes timed one after the other in each repetition and the median of
+  the per-repetition ratios kept. The median error of each code at each timed N is measured
+  on the evaluation timed, to show the match holds there.
 - **Scaling.** The engine's time against N and the exponent a of a least-squares fit of
-  time ~ N^a; the N where the tree (at its matched theta) becomes faster than the engine's
+  time ~ N^a; the N where the FMM (at its matched theta) becomes faster than the engine's
   direct sum (``method="direct"``), from the two timed side by side at small N.
 - **Memory.** ``engine.tree.layout.bytes_per_particle(N)``.
 
@@ -56,21 +60,24 @@ TARGET_ERROR = 1e-3
 #: the opening angles of the error curves (extended where the target is not bracketed)
 THETAS = (0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 1.0)
 #: the engine takes theta in [0, 2)
-MAX_THETA = {"engine": 1.9}
+MAX_THETA = {"engine": 1.9, "engine_tree": 1.9}
 #: a code whose one evaluation is predicted (or measured) above this is not timed (further)
 SLOW_SECONDS = 60.0
 #: at most about this many seconds of repetitions at one N
 REPEAT_BUDGET_SECONDS = 150.0
 
-CODES = ("engine", "pytreegrav", "pytreegrav_quadrupole", "rebound")
-LABELS = {"engine": "engine tree (quadrupole)", "pytreegrav": "pytreegrav (monopole)",
+CODES = ("engine", "engine_tree", "pytreegrav", "pytreegrav_quadrupole", "rebound")
+LABELS = {"engine": "engine FMM (quadrupole)",
+          "engine_tree": "engine Barnes-Hut (quadrupole)", "pytreegrav": "pytreegrav (monopole)",
           "pytreegrav_quadrupole": "pytreegrav (quadrupole)",
           "rebound": "REBOUND tree (monopole, 1 core)"}
 #: short names, for table headings
-SHORT = {"engine": "engine", "pytreegrav": "pytreegrav", "pytreegrav_quadrupole":
+SHORT = {"engine": "engine", "engine_tree": "engine Barnes-Hut", "pytreegrav": "pytreegrav",
+         "pytreegrav_quadrupole":
          "pytreegrav quadrupole", "rebound": "REBOUND"}
 #: the kernel each code's error is measured against
-KERNELS = {"engine": "plummer", "pytreegrav": "spline", "pytreegrav_quadrupole": "spline",
+KERNELS = {"engine": "plummer", "engine_tree": "plummer", "pytreegrav": "spline",
+           "pytreegrav_quadrupole": "spline",
            "rebound": "plummer"}
 
 #: sizes and repetitions by report level; the bench's full run is "full", --quick is "quick"
@@ -87,7 +94,7 @@ SIZES = {
     # process, for about 20 s)
     "smoke": {"error_n": 3000, "compare_n": (2000, 4000), "scaling_n": (2000, 4000, 8000),
               "crossover_n": (256, 512, 1024), "memory_n": 1_000_000,
-              "targets": 200, "repeats": 1, "codes": ("engine", "rebound")},
+              "targets": 200, "repeats": 1, "codes": ("engine", "engine_tree", "rebound")},
 }
 
 
@@ -182,7 +189,7 @@ def pick_targets(n, count, seed=12345):
 # -- the codes ------------------------------------------------------------------------------
 def available():
     """{code: None if it can run here, else why not}."""
-    out = {"engine": None}
+    out = {"engine": None, "engine_tree": None}
     for code, module in (("pytreegrav", "pytreegrav"), ("rebound", "rebound")):
         try:
             __import__(module)
@@ -206,7 +213,7 @@ def available():
 class EngineTree:
     """One evaluation: ``sim.accelerations()`` of ``NBodyGravity(method=...)``."""
 
-    def __init__(self, mass, pos, theta, method="tree"):
+    def __init__(self, mass, pos, theta, method="fmm"):
         from engine import Simulation, forces
 
         n = mass.shape[0]
@@ -286,6 +293,8 @@ def make(code, mass, pos, theta):
     """The evaluator of ``code`` (one of ``CODES``, or "direct": the engine's direct sum)."""
     if code == "engine":
         return EngineTree(mass, pos, theta)
+    if code == "engine_tree":
+        return EngineTree(mass, pos, theta, method="tree")
     if code == "direct":
         return EngineTree(mass, pos, 0.5, method="direct")
     if code in ("pytreegrav", "pytreegrav_quadrupole"):
@@ -362,17 +371,28 @@ def _predicted(times, n):
     return t * (n / m) * (math.log(n) / math.log(m))
 
 
-def compare_at(n, codes, thetas, repeats, seed=0, targets=1000, past=None):
+def tuned_theta(code, mass, pos, targets, exact, start, target=TARGET_ERROR):
+    """``code``'s theta for median error ``target`` on this very scene (an error curve at
+    start / 1.1, start and 1.1 start, extended until it brackets the target: ``error_curve``);
+    ``start`` if the curve never crosses it. (theta, the curve's rows)."""
+    curve = error_curve(code, mass, pos, targets, exact, thetas=(start / 1.1, start,
+                                                                  start * 1.1), target=target)
+    found = curve["theta_at_target"]
+    return (start if found is None else found), curve["rows"]
+
+
+def compare_at(n, codes, thetas, repeats, seed=0, targets=1000, past=None, tune=True):
     """One row of the equal-error comparison at n bodies: each code's median time of one
-    evaluation at its theta (in ``thetas``), the speed-ups of the engine (median of the
+    evaluation at its theta for the target error at this n (``tuned_theta``, from its theta in
+    ``thetas``; as given if not ``tune``), the speed-ups of the engine (median of the
     per-repetition ratios t_code / t_engine), and each code's median and 99th-percentile
-    error on this evaluation. ``past``: {code: {n: seconds}} of smaller N, to skip a code
+    error on the evaluation timed. ``past``: {code: {n: seconds}} of smaller N, to skip a code
     predicted to take more than ``SLOW_SECONDS``."""
     past = past if past is not None else {}
     mass, pos = plummer_sphere(n, seed)
     chosen = pick_targets(n, targets)
     exact = {k: exact_field(pos, mass, chosen, k) for k in {KERNELS[c] for c in codes}}
-    row = {"n": n, "time_s": {}, "error": {}, "notes": {}, "repeats": {}}
+    row = {"n": n, "time_s": {}, "error": {}, "notes": {}, "repeats": {}, "theta": {}}
     runs = {}
     for code in codes:
         guess = _predicted(past.get(code, {}), n)
@@ -380,7 +400,11 @@ def compare_at(n, codes, thetas, repeats, seed=0, targets=1000, past=None):
             row["notes"][code] = (f"not timed: one evaluation predicted to take {guess:.0f} s "
                                   f"(> {SLOW_SECONDS:.0f} s)")
             continue
-        ev = make(code, mass, pos, thetas[code])
+        theta = thetas[code]
+        if tune:
+            theta, _ = tuned_theta(code, mass, pos, chosen, exact[KERNELS[code]], theta)
+        row["theta"][code] = theta
+        ev = make(code, mass, pos, theta)
         first = _timed(ev.run)  # compiled code loaded; the result checked below
         row["error"][code] = error_stats(relative_errors(ev.accelerations()[chosen],
                                                          exact[KERNELS[code]]))
@@ -414,7 +438,7 @@ def compare_at(n, codes, thetas, repeats, seed=0, targets=1000, past=None):
 
 
 def scaling(sizes, theta, repeats, seed=0):
-    """The engine tree's median time of one evaluation at each N, and the exponent a of the
+    """The engine FMM's median time of one evaluation at each N, and the exponent a of the
     least-squares fit of log t = a log N + b."""
     times = []
     for n in sizes:
@@ -427,7 +451,7 @@ def scaling(sizes, theta, repeats, seed=0):
 
 
 def crossover_n(sizes, tree_s, direct_s):
-    """The N where the tree becomes faster than the direct sum: log-log interpolation of
+    """The N where the FMM becomes faster than the direct sum: log-log interpolation of
     t_tree / t_direct between the first pair of sizes where it falls below 1. None if it
     never does at these sizes; the smallest size if it is already below 1 there."""
     ratios = [a / b for a, b in zip(tree_s, direct_s)]
@@ -441,7 +465,7 @@ def crossover_n(sizes, tree_s, direct_s):
 
 
 def crossover(sizes, theta, repeats, seed=0):
-    """The engine's tree (at ``theta``) and direct sum timed side by side at each N."""
+    """The engine's FMM (at ``theta``) and direct sum timed side by side at each N."""
     tree_s, direct_s = [], []
     for n in sizes:
         mass, pos = plummer_sphere(n, seed)
@@ -530,29 +554,29 @@ def targets(t):
     rows = []
     big = _row(t, 1_000_000)
     if big and "engine" in big["time_s"]:
-        rows.append(("tree, N = 10^6: one force evaluation at median error 1e-3 in at most 1 s",
+        rows.append(("FMM, N = 10^6: one force evaluation at median error 1e-3 in at most 1 s",
                      f"{big['time_s']['engine']:.2f} s", big["time_s"]["engine"] <= 1.0))
     for n in (100_000, 1_000_000):
         r = _row(t, n)
         best = best_pytreegrav(r) if r else None
         if best:
-            rows.append((f"tree, N = {n:.0e}: at least 4x faster than pytreegrav at equal median "
+            rows.append((f"FMM, N = {n:.0e}: at least 4x faster than pytreegrav at equal median "
                          "error", f"{best[1]:.1f}x (against {LABELS[best[0]]})", best[1] >= 4.0))
     reb = [(r["n"], r["speedup"]["rebound"]) for r in t.get("compare", [])
            if "rebound" in r.get("speedup", {})]
     if reb:
-        rows.append(("tree: faster than REBOUND's tree at equal median error",
+        rows.append(("FMM: faster than REBOUND's tree at equal median error",
                      ", ".join(f"{s:.1f}x at N = {n:.0e}" for n, s in reb),
                      all(s > 1.0 for _, s in reb)))
     s = t.get("scaling")
     if s and s.get("exponent") is not None:
-        rows.append(("tree: time ~ N^a with a <= 1.15",
+        rows.append(("FMM: time ~ N^a with a <= 1.15",
                      f"a = {s['exponent']:.2f} (N = {s['n'][0]:.0e} to {s['n'][-1]:.0e})",
                      s["exponent"] <= 1.15))
     c = t.get("crossover")
     if c:
         n_x = c["crossover_n"]
-        rows.append(("tree faster than the direct sum from N <= 5000", _crossover_text(c),
+        rows.append(("FMM faster than the direct sum from N <= 5000", _crossover_text(c),
                      n_x is not None and n_x <= 5000))
     m = t.get("memory")
     if m:
@@ -565,7 +589,7 @@ def _crossover_text(c):
     if c["crossover_n"] is None:
         return f"direct sum still faster at N = {c['n'][-1]}"
     if c["below_range"]:
-        return f"tree already faster at N = {c['n'][0]}"
+        return f"FMM already faster at N = {c['n'][0]}"
     return f"N = {c['crossover_n']:.0f}"
 
 
@@ -587,6 +611,9 @@ def format_tree(t):
         lines.append(f"{r['n']:>9}" + "".join(f"{_seconds(r['time_s'].get(c)):>24}"
                                               for c in codes))
         lines.append(f"{'':>9}" + "".join(
+            f"{('theta %.3f' % r['theta'][c]) if c in r.get('theta', {}) else '':>24}"
+            for c in codes))
+        lines.append(f"{'':>9}" + "".join(
             f"{('%.1fx' % r['speedup'][c]) if c in r['speedup'] else '':>24}" for c in codes)
             + "   (engine speed-up)")
         for c, note in r["notes"].items():
@@ -598,7 +625,7 @@ def format_tree(t):
             + f"; exponent {s['exponent']:.2f}")
     c = t.get("crossover")
     if c:
-        lines.append("  tree / direct: " + ", ".join(
+        lines.append("  FMM / direct: " + ", ".join(
             f"{n} {a / b:.2f}" for n, a, b in zip(c["n"], c["tree_s"], c["direct_s"]))
             + f"; crossover {_crossover_text(c)}")
     m = t["memory"]
@@ -618,8 +645,9 @@ def markdown_tree(t):
            f"h = {t['spline_support']:g} (h = 2.8 eps: Springel, Yoshida & White 2001), and "
            "each code's error measured against the exact sum of its own kernel. The codes "
            f"are compared at equal median relative force error, {t['target_error']:g}: each "
-           f"at the theta where its error curve (N = {t['error']['n']}, "
-           f"{t['error']['targets']} bodies at random) crosses it. Times are of one force "
+           f"at the theta where its error curve ({t['error']['targets']} bodies at random) "
+           f"crosses it, found at N = {t['error']['n']} (the table below) and again on each "
+           "scene timed, around that theta (given with the times). Times are of one force "
            "evaluation (tree built, moments, walk), the median of repetitions timed one after "
            "the other; a speed-up is the median of the per-repetition ratios. The engine and "
            f"pytreegrav run on {t.get('threads', '?')} threads; REBOUND's pip build on one.", ""]
@@ -635,23 +663,26 @@ def markdown_tree(t):
             "|" + "---|" * (1 + 2 * len(codes) - 1)]
     for r in t["compare"]:
         out.append(f"| {r['n']:.0e} | " + " | ".join(
-            _seconds(r["time_s"].get(c)) + (f" ({r['error'][c]['median']:.1e})"
-                                            if c in r["error"] else "") for c in codes)
+            _seconds(r["time_s"].get(c)) + (f" ({r['error'][c]['median']:.1e}, "
+                                            f"theta {r['theta'][c]:.3f})"
+                                            if c in r["error"] and c in r.get("theta", {})
+                                            else "") for c in codes)
             + " | " + " | ".join(f"{r['speedup'][c]:.1f}x" if c in r["speedup"] else "—"
                                  for c in codes if c != "engine") + " |")
-    out += ["", "(In brackets: each code's median error on that evaluation.)"]
+    out += ["", "(In brackets: each code's median error on that evaluation, and its theta, "
+                "found for the target error on that scene.)"]
     notes = [f"N = {r['n']:.0e}, {c}: {note}" for r in t["compare"]
              for c, note in r["notes"].items()]
     if notes:
         out += [""] + [f"- {x}" for x in notes]
     s = t.get("scaling")
     if s:
-        out += ["", "| N | engine tree s |", "|---|---|"]
+        out += ["", "| N | engine FMM s |", "|---|---|"]
         out += [f"| {n:.0e} | {x:.3g} |" for n, x in zip(s["n"], s["time_s"])]
         out += ["", f"Fitted time ~ N^a: a = {s['exponent']:.2f}."]
     c = t.get("crossover")
     if c:
-        out += ["", "| N | tree s | direct s | tree / direct |", "|---|---|---|---|"]
+        out += ["", "| N | FMM s | direct s | FMM / direct |", "|---|---|---|---|"]
         out += [f"| {n} | {a:.3g} | {b:.3g} | {a / b:.2f} |"
                 for n, a, b in zip(c["n"], c["tree_s"], c["direct_s"])]
         out += ["", f"Crossover with the direct sum: {_crossover_text(c)}."]

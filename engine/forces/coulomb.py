@@ -76,9 +76,9 @@ class Coulomb(Force):
     ``box`` (deprecated): side of a periodic domain for this term alone; declare the space
     once instead (``Simulation(box=L)``), and pairs interact through their nearest image.
 
-    ``method``, ``theta``, ``order``: as ``NBodyGravity``'s (``"tree"``: the Barnes-Hut tree,
-    ``engine.forces.coulomb_tree``; charges of both signs, so the quadrupole ``order=2``, the
-    default, is what keeps a neutral plasma's error small).
+    ``method``, ``theta``, ``order``: as ``NBodyGravity``'s (``"fmm"`` and ``"tree"``: the
+    tree's two walks, ``engine.forces.coulomb_tree``; charges of both signs, so the quadrupole
+    ``order=2``, the default, is what keeps a neutral plasma's error small).
     """
 
     KIND = KIND

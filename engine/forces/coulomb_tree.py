@@ -1,5 +1,5 @@
-"""Coulomb's law by the Barnes-Hut tree: ``Coulomb(method="tree")`` (and "auto" above its
-threshold).
+"""Coulomb's law by the tree: ``Coulomb(method="fmm")`` (and "auto" above its threshold), by
+its fast multipole walk, and ``method="tree"``, by its Barnes-Hut walk.
 
 The field of every active charged particle is taken from ``engine.tree`` (uncharged and
 inactive particles take no part, as in the direct sum), with alpha_i = -k q_i / m_i and
@@ -10,7 +10,9 @@ beta_j = q_j:
 Charges of both signs cancel in a cell's total: a neutral cell acts through its dipole and
 quadrupole, which is why ``order=2`` (the default) is needed for a plasma (the error of a
 neutral plasma against theta is in docs/engine.md). Near pairs are summed directly, far cells
-by their multipoles about their centres (Barnes & Hut 1986, Nature 324, 446; Barnes 1990). The error falls with ``theta`` and is 0 to round-off
+by their multipoles about their centres (Barnes & Hut 1986, Nature 324, 446; Barnes 1990), at
+each target or through local expansions passed down the tree (``engine.tree.fmm``). The error
+falls with ``theta`` and is 0 to round-off
 at theta = 0 (every pair summed). Forces are not antisymmetric pair by pair, so total momentum
 drifts at the level of the force error (the direct sum keeps it to round-off).
 
@@ -23,7 +25,7 @@ import math
 from ..cache import jit
 
 from ..tree import field, layout
-from . import coulomb
+from . import coulomb, tree_terms
 
 KIND = 11
 
@@ -54,7 +56,8 @@ def accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work):
         m = _members(state, field.blocks(work.floats, n), field.slots_of(work.ints, n),
                      params[f0])
         if field.add_field(state.pos, n, m, work.floats, work.ints, params[f0 + 3],
-                           params[f0 + 1], int(params[f0 + 4]), work.threads, acc):
+                           params[f0 + 1], int(params[f0 + 4]), work.threads,
+                           tree_terms.multipole(params[f0 + 5]), acc):
             return
     coulomb.accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work)
 
@@ -77,7 +80,8 @@ def tree_potential(state, params, f0, work):
     if m == 0:
         return 0.0
     field.solve(state.pos, n, m, work.floats, work.ints, params[f0 + 3], params[f0 + 1],
-                int(params[f0 + 4]), True, work.threads)
+                int(params[f0 + 4]), True, work.threads,
+                tree_terms.multipole(params[f0 + 5]))
     u = 0.0
     for k in range(m):
         u += 0.5 * params[f0] * state.charge[slots[k]] * part[8, k]

@@ -155,10 +155,11 @@ class NBodyGravity(Force):
     raises SimulationError), and a scene of distant clumps loses accuracy in proportion.
     Positions, velocities, the small-N loop and the potential energy stay in float64.
 
-    ``method``: ``"direct"`` (the default) sums every pair, exactly; ``"tree"`` takes the
-    field from a Barnes-Hut tree with opening angle ``theta`` (in [0, 2); 0 sums every pair)
-    and multipoles to ``order`` (2: quadrupole) about each cell's centre, in O(N log N);
-    ``"auto"`` sums directly below ``tree_terms.DIRECT_BELOW`` particles and uses the tree
+    ``method``: ``"direct"`` (the default) sums every pair, exactly; ``"fmm"`` takes the
+    field from the tree's fast multipole walk, in O(N), and ``"tree"`` from its Barnes-Hut
+    walk, in O(N log N), both with opening angle ``theta`` (in [0, 2); 0 sums every pair) and
+    multipoles to ``order`` (2: quadrupole) about each cell's centre; ``"auto"`` sums
+    directly below ``tree_terms.DIRECT_BELOW`` particles and uses the fast multipole walk
     above (``engine.forces.tree_terms``, ``engine.forces.gravity_tree``: what it costs and
     where it cannot act). The tree computes in float64 (``precision="float32"`` is the
     direct sum's).

@@ -1,5 +1,5 @@
-"""Gravity by the Barnes-Hut tree: ``NBodyGravity(method="tree")`` (and "auto" above its
-threshold).
+"""Gravity by the tree: ``NBodyGravity(method="fmm")`` (and "auto" above its threshold), by
+its fast multipole walk, and ``method="tree"``, by its Barnes-Hut walk.
 
 The field of every active particle is taken from ``engine.tree`` (sources: the active
 particles that are not test particles and have mass; targets: every active particle), with
@@ -8,7 +8,8 @@ alpha = 1 and beta_j = G m_j:
     a_i = sum_j G m_j (p_j - p_i) / (|p_j - p_i|^2 + eps^2)^(3/2)
 
 summed directly for near pairs and by each far cell's multipoles about its centre (Barnes &
-Hut 1986, Nature 324, 446; Barnes 1990). The error falls with ``theta`` and is 0 to round-off
+Hut 1986, Nature 324, 446; Barnes 1990), at each target or through local expansions passed
+down the tree (``engine.tree.fmm``). The error falls with ``theta`` and is 0 to round-off
 at theta = 0 (every pair summed). Forces are not antisymmetric pair by pair, so total momentum
 drifts at the level of the force error (the direct sum keeps it to round-off).
 
@@ -21,7 +22,7 @@ import math
 from ..cache import jit
 
 from ..tree import field, layout
-from . import gravity
+from . import gravity, tree_terms
 
 KIND = 10
 
@@ -49,7 +50,8 @@ def accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work):
         m = _members(state, field.blocks(work.floats, n), field.slots_of(work.ints, n),
                      params[f0])
         if field.add_field(state.pos, n, m, work.floats, work.ints, params[f0 + 4],
-                           params[f0 + 1], int(params[f0 + 5]), work.threads, acc):
+                           params[f0 + 1], int(params[f0 + 5]), work.threads,
+                           tree_terms.multipole(params[f0 + 6]), acc):
             return
     gravity.accumulate(t, state, params, f0, f1, indices, i0, i1, acc, work)
 
@@ -72,7 +74,8 @@ def tree_potential(state, params, f0, work):
     if m == 0:
         return 0.0
     field.solve(state.pos, n, m, work.floats, work.ints, params[f0 + 4], params[f0 + 1],
-                int(params[f0 + 5]), True, work.threads)
+                int(params[f0 + 5]), True, work.threads,
+                tree_terms.multipole(params[f0 + 6]))
     u = 0.0
     for k in range(m):
         i = slots[k]

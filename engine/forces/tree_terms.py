@@ -1,11 +1,15 @@
 """What the tree methods of ``NBodyGravity`` and ``Coulomb`` share: their parameters and rules.
 
 ``method="direct"`` (the default) sums every pair, exactly; ``"tree"`` evaluates the field
-with the Barnes-Hut tree of ``engine.tree`` and its opening angle ``theta`` (0 sums every pair,
-through the tree; larger is faster and less accurate; below 2) and multipole ``order`` (0, 1
-or 2: monopole, dipole, quadrupole about each cell's centre); ``"auto"`` sums directly in a
-simulation of fewer than ``DIRECT_BELOW`` particle slots (``sim.n``, inactive ones included:
-the count every rule here is decided on) and uses the tree from there on. The threshold is a constant,
+with the Barnes-Hut tree of ``engine.tree`` (``engine.tree.walk``: a walk from the root for
+every group of targets) and its opening angle ``theta`` (0 sums every pair, through the tree;
+larger is faster and less accurate; below 2) and multipole ``order`` (0, 1 or 2: monopole,
+dipole, quadrupole about each cell's centre); ``"fmm"`` evaluates it with the same tree, cells
+acting on cells through local expansions passed down the tree (``engine.tree.fmm``, a fast
+multipole method: cost growing as N rather than N log N), with the same parameters (below
+theta 0.2 it walks as ``"tree"`` does); ``"auto"`` sums directly in a simulation of fewer than
+``DIRECT_BELOW`` particle slots (``sim.n``, inactive ones included: the count every rule here
+is decided on) and uses ``"fmm"`` from there on. The threshold is a constant,
 not measured on the machine that runs, so that a scene gives the same result everywhere.
 
 A tree term runs in a ``Simulation`` in open space. ``engine.Batch`` refuses it (its systems
@@ -13,18 +17,19 @@ are small, where the direct sum is faster), as do a periodic space (the tree has
 images) and the whfast, saba and ias15 integrators (see ``check_integrator``).
 """
 from .._validate import finite_float, int_in_range, one_of
+from ..cache import jit
 
-METHODS = ("direct", "tree", "auto")
+METHODS = ("direct", "tree", "fmm", "auto")
 #: the packed code of each method
-METHOD_CODES = {"direct": 0.0, "tree": 1.0, "auto": 2.0}
+METHOD_CODES = {"direct": 0.0, "tree": 1.0, "auto": 2.0, "fmm": 3.0}
 #: the multipole orders the tree offers (``engine.tree.multipoles``)
 ORDERS = (0, 1, 2)
 #: ``method="auto"`` sums directly below this many interacting particles: about where the
-#: tree at median force error 1e-3 overtakes the direct sum (1241 and 1351 bodies in two runs
-#: on the 2-core AMD EPYC of docs/performance.md, Plummer sphere, both cores; ``python -m validation bench``,
-#: section "tree"). A constant, the same on every machine, so that results do not depend on
-#: where they run
-DIRECT_BELOW = 1500
+#: fast multipole walk at median force error 1e-3 overtakes the direct sum (1744 and 1882
+#: bodies in two runs on the 2-core AMD EPYC of docs/performance.md, Plummer sphere, both
+#: cores; ``python -m validation bench``, section "tree"). A constant, the same on every
+#: machine, so that results do not depend on where they run
+DIRECT_BELOW = 1800
 #: integrators that refuse tree terms, and why
 REFUSING_INTEGRATORS = {
     "whfast": "its Kepler splitting is made for a few bodies around a dominant mass",
@@ -56,7 +61,14 @@ def check_order(name, value):
 def uses_tree(term, n):
     """Does ``term`` evaluate by the tree in a system of n particle slots?"""
     method = getattr(term, "method", "direct")
-    return method == "tree" or (method == "auto" and n >= DIRECT_BELOW)
+    return method in ("tree", "fmm") or (method == "auto" and n >= DIRECT_BELOW)
+
+
+@jit(error_model="numpy", inline="always")
+def multipole(code):
+    """Does a tree term of packed method ``code`` walk by the fast multipole method ("fmm",
+    and "auto" above its threshold) rather than Barnes-Hut's ("tree")?"""
+    return code != 1.0
 
 
 def check_owner(term, sim):

@@ -8,14 +8,16 @@ For n particle slots and C = ``cell_capacity(n)`` cells, the floats hold, in ord
   quadrupole), size, radius, absolute weight and bounding box (6);
 - per thread, its interaction lists: ``LIST_PARTICLES`` particles (x, y, z, beta), twice
   ``LIST_CELLS`` cells (centre and multipoles: summed at each target, or into the group's
-  local expansion) and the local expansion (``LOCAL``);
+  local expansion) and the local expansion (``LOCAL``), and the fast multipole walk's local
+  expansion for each of ``DEPTH`` levels;
 
 and the ints: the sort's keys and slots and their copies (4 blocks of n), the radix sort's
 counts, ``CELL_INTS`` blocks of C (first particle, count, first child, children, and the list
-of leaves) and each thread's stack.
+of leaves) and each thread's stack, the fast multipole walk's candidates and frames and its
+outcome.
 
 At 8 bytes a number that is 20 n floats and 6.5 n ints (C = n / 2): 212 bytes a particle,
-plus 279 KB per thread for its lists.
+plus 1.4 MB per thread (320 KB of lists, 1 MB of the fast multipole walk's candidates).
 """
 import numpy as np
 from numba import config
@@ -34,10 +36,20 @@ LIST_PARTICLES = 2048
 LIST_CELLS = 1024
 #: a group's local expansion: field (3), gradient (6), second derivatives (10), potential (10)
 LOCAL = 32
-LIST_FLOATS = 4 * LIST_PARTICLES + 2 * 13 * LIST_CELLS + LOCAL
+#: the fast multipole walk's frames (``fmm``): a cell's level in the tree, at most (a deeper
+#: tree, from ranges keyed again in their own cubes, is walked by ``walk`` instead)
+DEPTH = 160
+LIST_FLOATS = 4 * LIST_PARTICLES + 2 * 13 * LIST_CELLS + LOCAL + DEPTH * LOCAL
 #: one thread's walk stack (a compressed tree of 64-bit keys is at most 31 levels deep, and
 #: a level pushes at most 8 cells)
 STACK = 512
+#: the fast multipole walk's candidates: the lists of the cells on the path from the root and
+#: the cell being resolved (a scene that needs more is walked by ``walk`` instead), and as many
+#: for a cell's deferred list; a frame per level: cell, next child, list start and length;
+#: and the lane's outcome (0, or -1 if the scratch ran out)
+CANDIDATES = 1 << 16
+FRAME_INTS = 4
+LANE_INTS = STACK + 2 * CANDIDATES + FRAME_INTS * DEPTH + 1
 #: the radix sort's digit: 11 bits, so 63-bit keys sort in 6 passes
 RADIX_BITS = 11
 RADIX = 1 << RADIX_BITS
@@ -63,7 +75,7 @@ def float_count(n, threads):
 
 @jit(error_model="numpy", inline="always")
 def int_count(n, threads):
-    return 4 * n + RADIX + 1 + CELL_INTS * cell_capacity(n) + threads * STACK
+    return 4 * n + RADIX + 1 + CELL_INTS * cell_capacity(n) + threads * LANE_INTS
 
 
 @jit(error_model="numpy", inline="always")
@@ -117,15 +129,38 @@ def lane_lists(floats, n, lane):
 @jit(error_model="numpy", inline="always")
 def lane_stack(ints, n, lane):
     """Lane ``lane``'s walk stack (lane 0's also serves the build)."""
-    own = int_count(n, 0) + lane * STACK
+    own = int_count(n, 0) + lane * LANE_INTS
     return ints[own:own + STACK]
+
+
+@jit(error_model="numpy", inline="always")
+def lane_descent(floats, ints, n, lane):
+    """Lane ``lane``'s scratch for the fast multipole walk: the candidates, the deferred
+    list, the frames (cell, next child, list start, list length) and each frame's local
+    expansion, (DEPTH, LOCAL)."""
+    own = int_count(n, 0) + lane * LANE_INTS + STACK
+    cand = ints[own:own + CANDIDATES]
+    deferred = ints[own + CANDIDATES:own + 2 * CANDIDATES]
+    f = own + 2 * CANDIDATES
+    frames = ints[f:f + FRAME_INTS * DEPTH].reshape((FRAME_INTS, DEPTH))
+    base = (PARTICLE_FLOATS * n + CELL_FLOATS * cell_capacity(n) + lane * LIST_FLOATS
+            + 4 * LIST_PARTICLES + 2 * 13 * LIST_CELLS + LOCAL)
+    locals_ = floats[base:base + DEPTH * LOCAL].reshape((DEPTH, LOCAL))
+    return cand, deferred, frames[0], frames[1], frames[2], frames[3], locals_
+
+
+@jit(error_model="numpy", inline="always")
+def lane_status(ints, n, lane):
+    """Lane ``lane``'s outcome of the fast multipole walk, a 1-element block."""
+    own = int_count(n, 0) + (lane + 1) * LANE_INTS - 1
+    return ints[own:own + 1]
 
 
 @jit(error_model="numpy", inline="always")
 def lanes(floats, ints, n):
     """How many threads' lists and stacks a workspace for n slots holds."""
     by_floats = (floats.shape[0] - float_count(n, 0)) // LIST_FLOATS
-    by_ints = (ints.shape[0] - int_count(n, 0)) // STACK
+    by_ints = (ints.shape[0] - int_count(n, 0)) // LANE_INTS
     return min(by_floats, by_ints)
 
 

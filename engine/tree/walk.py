@@ -7,20 +7,24 @@ rather than per particle), a cell is taken by its multipoles when
     size < theta * d   and   d > radius
 
 with d the distance from the group's bounding box to the cell's centre, ``size`` the cell's
-largest side and ``radius`` its half diagonal (the second keeps every target outside the
-sphere where the expansion converges, whatever theta). Since d is measured from the group's
+largest side and ``radius`` the largest distance of its particles from its centre
+(``multipoles``; the second condition keeps every target outside the sphere where the
+expansion converges, whatever theta). Since d is measured from the group's
 nearest point, no particle of the group gets a coarser answer than the criterion would give it
 alone. A cell so taken that holds at most ``small`` particles goes on the particle list
 instead (as cheap, and exact); so do the leaves that are not taken, while other cells are
 opened. theta = 0 takes no cell: every pair is summed directly, as the direct sum does.
 
-A far cell well separated from the whole group (its radius plus the group's below
-``LOCAL_SHARE * theta`` times the distance between their centres) goes on a third list, whose
+A cell well separated from the whole group (its radius plus the group's below ``LOCAL_SHARE *
+theta`` times the distance between their centres, and more than 4 ``small`` particle pairs
+between them: fewer are summed pair by pair, as cheap and exact) goes on a third list, whose
 cells are summed once into a local expansion about the group's centre (field, gradient and
 second derivatives: the cell-to-group step, M2L, of a fast multipole method, Greengard &
 Rokhlin 1987, J. Comput. Phys. 73, 325, to total order 2 in the cell's radius and the target's
 offset), evaluated once at each target (L2P): a cell costs one M2L for the group instead of one
-multipole sum per target. Its error is of the same (third) order as the multipoles' own.
+multipole sum per target (``local``). Its error is of the same (third) order as the
+multipoles' own. ``fmm`` takes the same steps for the cells above the groups, and at the
+groups takes what is left as ``walk_group`` does.
 
 The lists are summed for each target in loops without branches (``sum_particles``,
 ``sum_cells``, ``cells_to_local``) that the compiler vectorises; a list that fills is summed and emptied, so the
@@ -35,7 +39,7 @@ from numba import prange
 
 from ..cache import jit
 
-from . import layout, multipoles as mp
+from . import layout, local, multipoles as mp
 
 #: a far cell whose radius plus the group's is below LOCAL_SHARE * theta times the distance
 #: between their centres acts through one local expansion about the group's centre (its field,
@@ -45,7 +49,7 @@ from . import layout, multipoles as mp
 LOCAL_SHARE = 0.75
 
 #: the vectorising flags of ``engine.forces.pairwise`` (never 'nnan'/'ninf': NaN must survive)
-SIMD_MATH = {"reassoc", "contract", "nsz", "arcp"}
+SIMD_MATH = local.SIMD_MATH
 
 
 @jit(fastmath=SIMD_MATH, error_model="numpy")
@@ -116,171 +120,6 @@ def sum_cells(px, py, pz, s, e, lc, count, eps2, ax, ay, az, phi, potential):
 
 
 @jit(fastmath=SIMD_MATH, error_model="numpy")
-def cells_to_local(lc, count, zx, zy, zz, eps2, loc):
-    """loc += the local expansion about z of the listed cells' fields (M2L; module
-    ``multipoles``): loc[0:3] the field F, loc[3:9] its gradient G (xx, yy, zz, xy, xz, yz),
-    loc[9:19] the second derivatives H (xxx, yyy, zzz, xxy, xxz, xyy, yyz, xzz, yzz, xyz)."""
-    fx = fy = fz = 0.0
-    gxx = gyy = gzz = gxy = gxz = gyz = 0.0
-    hxxx = hyyy = hzzz = hxxy = hxxz = hxyy = hyyz = hxzz = hyzz = hxyz = 0.0
-    for j in range(count):
-        dx = lc[mp.CX, j] - zx
-        dy = lc[mp.CY, j] - zy
-        dz = lc[mp.CZ, j] - zz
-        m = lc[mp.M, j]
-        ex = lc[mp.DX, j]
-        ey = lc[mp.DY, j]
-        ez = lc[mp.DZ, j]
-        qxx = lc[mp.QXX, j]
-        qyy = lc[mp.QYY, j]
-        qzz = lc[mp.QZZ, j]
-        qxy = lc[mp.QXY, j]
-        qxz = lc[mp.QXZ, j]
-        qyz = lc[mp.QYZ, j]
-        inv = 1.0 / math.sqrt(dx * dx + dy * dy + dz * dz + eps2)
-        inv2 = inv * inv
-        inv3 = inv * inv2
-        inv5 = inv3 * inv2
-        inv7 = inv5 * inv2
-        dd = ex * dx + ey * dy + ez * dz
-        qx = qxx * dx + qxy * dy + qxz * dz
-        qy = qxy * dx + qyy * dy + qyz * dz
-        qz = qxz * dx + qyz * dy + qzz * dz
-        dqd = qx * dx + qy * dy + qz * dz
-        trace = qxx + qyy + qzz
-        common = m * inv3 - 3.0 * dd * inv5 + 7.5 * dqd * inv7 - 1.5 * trace * inv5
-        fx += common * dx + inv3 * ex - 3.0 * inv5 * qx
-        fy += common * dy + inv3 * ey - 3.0 * inv5 * qy
-        fz += common * dz + inv3 * ez - 3.0 * inv5 * qz
-        # G_kl = M g_kl + D_i g_ikl
-        a = 3.0 * m * inv5 - 15.0 * dd * inv7
-        b = m * inv3 - 3.0 * dd * inv5
-        c3 = 3.0 * inv5
-        gxx += a * dx * dx - b + c3 * 2.0 * ex * dx
-        gyy += a * dy * dy - b + c3 * 2.0 * ey * dy
-        gzz += a * dz * dz - b + c3 * 2.0 * ez * dz
-        gxy += a * dx * dy + c3 * (ex * dy + ey * dx)
-        gxz += a * dx * dz + c3 * (ex * dz + ez * dx)
-        gyz += a * dy * dz + c3 * (ey * dz + ez * dy)
-        # H_klm = -M g_klm / 2 = S d_k d_l d_m - T (delta_kl d_m + delta_km d_l + delta_lm d_k)
-        s = 7.5 * m * inv7
-        t = 1.5 * m * inv5
-        hxxx += s * dx * dx * dx - 3.0 * t * dx
-        hyyy += s * dy * dy * dy - 3.0 * t * dy
-        hzzz += s * dz * dz * dz - 3.0 * t * dz
-        hxxy += s * dx * dx * dy - t * dy
-        hxxz += s * dx * dx * dz - t * dz
-        hxyy += s * dx * dy * dy - t * dx
-        hyyz += s * dy * dy * dz - t * dz
-        hxzz += s * dx * dz * dz - t * dx
-        hyzz += s * dy * dz * dz - t * dy
-        hxyz += s * dx * dy * dz
-    loc[0] += fx
-    loc[1] += fy
-    loc[2] += fz
-    loc[3] += gxx
-    loc[4] += gyy
-    loc[5] += gzz
-    loc[6] += gxy
-    loc[7] += gxz
-    loc[8] += gyz
-    loc[9] += hxxx
-    loc[10] += hyyy
-    loc[11] += hzzz
-    loc[12] += hxxy
-    loc[13] += hxxz
-    loc[14] += hxyy
-    loc[15] += hyyz
-    loc[16] += hxzz
-    loc[17] += hyzz
-    loc[18] += hxyz
-
-
-@jit(fastmath=SIMD_MATH, error_model="numpy")
-def cells_to_local_potential(lc, count, zx, zy, zz, eps2, loc):
-    """loc[19:29] += the local expansion about z of the listed cells' potential: P0, P1
-    (x, y, z), P2 (xx, yy, zz, xy, xz, yz), psi(z + delta) = P0 + P1.delta + delta.P2.delta."""
-    p0 = 0.0
-    px_ = py_ = pz_ = 0.0
-    pxx = pyy = pzz = pxy = pxz = pyz = 0.0
-    for j in range(count):
-        dx = lc[mp.CX, j] - zx
-        dy = lc[mp.CY, j] - zy
-        dz = lc[mp.CZ, j] - zz
-        m = lc[mp.M, j]
-        ex = lc[mp.DX, j]
-        ey = lc[mp.DY, j]
-        ez = lc[mp.DZ, j]
-        qxx = lc[mp.QXX, j]
-        qyy = lc[mp.QYY, j]
-        qzz = lc[mp.QZZ, j]
-        qxy = lc[mp.QXY, j]
-        qxz = lc[mp.QXZ, j]
-        qyz = lc[mp.QYZ, j]
-        inv = 1.0 / math.sqrt(dx * dx + dy * dy + dz * dz + eps2)
-        inv2 = inv * inv
-        inv3 = inv * inv2
-        inv5 = inv3 * inv2
-        dd = ex * dx + ey * dy + ez * dz
-        dqd = (qxx * dx * dx + qyy * dy * dy + qzz * dz * dz
-               + 2.0 * (qxy * dx * dy + qxz * dx * dz + qyz * dy * dz))
-        trace = qxx + qyy + qzz
-        p0 += m * inv - dd * inv3 + 1.5 * dqd * inv5 - 0.5 * trace * inv3
-        # P1_l = M d_l / r^3 - 3 (D.d) d_l / r^5 + D_l / r^3
-        u = m * inv3 - 3.0 * dd * inv5
-        px_ += u * dx + ex * inv3
-        py_ += u * dy + ey * inv3
-        pz_ += u * dz + ez * inv3
-        # P2_lm = M (3 d_l d_m / r^5 - delta_lm / r^3) / 2
-        v = 1.5 * m * inv5
-        w = 0.5 * m * inv3
-        pxx += v * dx * dx - w
-        pyy += v * dy * dy - w
-        pzz += v * dz * dz - w
-        pxy += v * dx * dy
-        pxz += v * dx * dz
-        pyz += v * dy * dz
-    loc[19] += p0
-    loc[20] += px_
-    loc[21] += py_
-    loc[22] += pz_
-    loc[23] += pxx
-    loc[24] += pyy
-    loc[25] += pzz
-    loc[26] += pxy
-    loc[27] += pxz
-    loc[28] += pyz
-
-
-@jit(fastmath=SIMD_MATH, error_model="numpy")
-def local_to_targets(px, py, pz, s, e, zx, zy, zz, loc, ax, ay, az, phi, potential):
-    """Targets [s, e) += the local expansion about z (L2P)."""
-    for i in range(s, e):
-        x = px[i] - zx
-        y = py[i] - zy
-        z = pz[i] - zz
-        xx = x * x
-        yy = y * y
-        zz2 = z * z
-        xy = 2.0 * x * y
-        xz = 2.0 * x * z
-        yz = 2.0 * y * z
-        ax[i] += (loc[0] + loc[3] * x + loc[6] * y + loc[7] * z
-                  + loc[9] * xx + loc[14] * yy + loc[16] * zz2
-                  + loc[12] * xy + loc[13] * xz + loc[18] * yz)
-        ay[i] += (loc[1] + loc[6] * x + loc[4] * y + loc[8] * z
-                  + loc[12] * xx + loc[10] * yy + loc[17] * zz2
-                  + loc[14] * xy + loc[18] * xz + loc[15] * yz)
-        az[i] += (loc[2] + loc[7] * x + loc[8] * y + loc[5] * z
-                  + loc[13] * xx + loc[15] * yy + loc[11] * zz2
-                  + loc[18] * xy + loc[16] * xz + loc[17] * yz)
-        if potential:
-            phi[i] += (loc[19] + loc[20] * x + loc[21] * y + loc[22] * z
-                       + loc[23] * xx + loc[24] * yy + loc[25] * zz2
-                       + loc[26] * xy + loc[27] * xz + loc[28] * yz)
-
-
-@jit(fastmath=SIMD_MATH, error_model="numpy")
 def sum_own_group(px, py, pz, beta, s, e, eps2, ax, ay, az, phi, potential):
     """Targets [s, e) += the field of the other sources of their own group: the pair of a
     particle with itself, and pairs with particles that are not sources (which the direct sum
@@ -346,6 +185,7 @@ def walk_group(group, px, py, pz, beta, ax, ay, az, phi, cells, start, count, ch
     """Everything the particles of ``group`` feel, into ax, ay, az (and phi)."""
     s = start[group]
     e = s + count[group]
+    gcount = count[group]
     for i in range(s, e):
         ax[i] = 0.0
         ay[i] = 0.0
@@ -387,23 +227,23 @@ def walk_group(group, px, py, pz, beta, ax, ay, az, phi, cells, start, count, ch
         size = cells[mp.SIZE, c]
         radius = cells[mp.RADIUS, c]
         far = size * size < theta2 * d2 and d2 > radius * radius
-        if far and count[c] > small:
-            rx = cells[mp.CX, c] - zx
-            ry = cells[mp.CY, c] - zy
-            rz = cells[mp.CZ, c] - zz
-            spread = radius + reach
-            if spread * spread < local2 * (rx * rx + ry * ry + rz * rz):
-                if nlocal == clist:
-                    flush_local(ll, nlocal, zx, zy, zz, eps2, loc, potential)
-                    nlocal = 0
-                copy_cell(cells, c, ll, nlocal, order)
-                nlocal += 1
-            else:
-                if ncell == clist:
-                    sum_cells(px, py, pz, s, e, lc, ncell, eps2, ax, ay, az, phi, potential)
-                    ncell = 0
-                copy_cell(cells, c, lc, ncell, order)
-                ncell += 1
+        rx = cells[mp.CX, c] - zx
+        ry = cells[mp.CY, c] - zy
+        rz = cells[mp.CZ, c] - zz
+        spread = radius + reach
+        if count[c] * gcount > 4 * small and spread * spread < local2 * (rx * rx + ry * ry
+                                                                          + rz * rz):
+            if nlocal == clist:
+                local.flush(ll, nlocal, zx, zy, zz, eps2, loc, potential)
+                nlocal = 0
+            copy_cell(cells, c, ll, nlocal, order)
+            nlocal += 1
+        elif far and count[c] > small:
+            if ncell == clist:
+                sum_cells(px, py, pz, s, e, lc, ncell, eps2, ax, ay, az, phi, potential)
+                ncell = 0
+            copy_cell(cells, c, lc, ncell, order)
+            ncell += 1
         elif far or children[c] == 0:
             for k in range(start[c], start[c] + count[c]):
                 if beta[k] == 0.0:
@@ -427,15 +267,10 @@ def walk_group(group, px, py, pz, beta, ax, ay, az, phi, cells, start, count, ch
     if ncell:
         sum_cells(px, py, pz, s, e, lc, ncell, eps2, ax, ay, az, phi, potential)
     if nlocal:
-        flush_local(ll, nlocal, zx, zy, zz, eps2, loc, potential)
-        local_to_targets(px, py, pz, s, e, zx, zy, zz, loc, ax, ay, az, phi, potential)
+        local.flush(ll, nlocal, zx, zy, zz, eps2, loc, potential)
+        local.local_to_targets(px, py, pz, s, e, zx, zy, zz, loc, ax, ay, az, phi, potential)
 
 
-@jit(error_model="numpy", inline="always")
-def flush_local(ll, count, zx, zy, zz, eps2, loc, potential):
-    cells_to_local(ll, count, zx, zy, zz, eps2, loc)
-    if potential:
-        cells_to_local_potential(ll, count, zx, zy, zz, eps2, loc)
 
 
 @jit(error_model="numpy")
@@ -448,8 +283,8 @@ def walk_lane(lane, lanes, floats, ints, n, ngroups, theta2, eps2, order, potent
     stack = layout.lane_stack(ints, n, lane)
     for g in range(lane, ngroups, lanes):
         walk_group(groups[g], part[0], part[1], part[2], part[3], part[5], part[6], part[7],
-                  part[8], cells, start, count, child, children, lx, ly, lz, lb, lc, ll, loc, stack,
-                  theta2, eps2, order, potential, small)
+                   part[8], cells, start, count, child, children, lx, ly, lz, lb, lc, ll, loc,
+                   stack, theta2, eps2, order, potential, small)
 
 
 #: one signature for both walks (see ``engine.forces.pairwise``: a parallel function is

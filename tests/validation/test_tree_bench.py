@@ -93,20 +93,37 @@ def test_relative_errors_and_their_statistics():
 def test_trees_at_theta_zero_are_the_exact_sum():
     """At theta = 0 every code sums every pair: the row's errors are round-off, so they are
     measured against the same field (kernel, softening, G) the codes compute."""
-    codes = ["engine"] + (["rebound"] if tb.available()["rebound"] is None else [])
-    row = tb.compare_at(1500, codes, {c: 0.0 for c in codes}, repeats=1, seed=3, targets=150)
+    codes = ["engine", "engine_tree"] + (["rebound"] if tb.available()["rebound"] is None
+                                         else [])
+    row = tb.compare_at(1500, codes, {c: 0.0 for c in codes}, repeats=1, seed=3, targets=150,
+                        tune=False)
     for code in codes:
         assert row["error"][code]["p99"] < 1.5e-14  # measured 2.7e-15 and 3.5e-15
+        assert row["theta"][code] == 0.0
     # and a tree error at theta 0.5 is of the size the error curves show (not round-off)
-    row = tb.compare_at(1500, ["engine"], {"engine": 0.5}, repeats=1, seed=3, targets=150)
+    row = tb.compare_at(1500, ["engine", "engine_tree"], {"engine": 0.5, "engine_tree": 0.5},
+                        repeats=1, seed=3, targets=150, tune=False)
     assert 6e-5 < row["error"]["engine"]["median"] < 6e-4  # measured 1.9e-4
+    assert 6e-5 < row["error"]["engine_tree"]["median"] < 6e-4  # measured 1.9e-4
+
+
+def test_each_code_is_tuned_to_the_target_error_at_each_n():
+    """By default a row times each code at its own theta for the target error on that very
+    scene: its median error on the evaluation timed is the target's to the interpolation's
+    accuracy (measured within 10%), whatever theta it started from."""
+    row = tb.compare_at(3000, ["engine", "engine_tree"], {"engine": 0.3, "engine_tree": 1.0},
+                        repeats=1, seed=3, targets=300)
+    for code in ("engine", "engine_tree"):
+        assert row["theta"][code] not in (0.3, 1.0)
+        assert 0.7 * tb.TARGET_ERROR < row["error"][code]["median"] < 1.4 * tb.TARGET_ERROR
 
 
 def test_compare_rows_have_their_fields():
     codes = ["engine"] + (["rebound"] if tb.available()["rebound"] is None else [])
     row = tb.compare_at(1000, codes, {c: 0.6 for c in codes}, repeats=2, targets=100)
     assert row["n"] == 1000
-    assert set(row["time_s"]) == set(codes) == set(row["error"]) == set(row["repeats"])
+    assert set(row["time_s"]) == set(codes) == set(row["error"]) == set(row["repeats"]) \
+        == set(row["theta"])
     assert set(row["speedup"]) == set(codes) - {"engine"}
     for code in codes:
         assert row["time_s"][code] > 0 and row["repeats"][code] == 2
@@ -118,7 +135,8 @@ def test_compare_rows_have_their_fields():
 def test_a_code_predicted_too_slow_is_not_timed():
     past = {"engine": {100: 1e-4}, "rebound": {100: 30.0}}
     codes = ["engine"] + (["rebound"] if tb.available()["rebound"] is None else [])
-    row = tb.compare_at(1000, codes, {c: 0.6 for c in codes}, repeats=1, targets=50, past=past)
+    row = tb.compare_at(1000, codes, {c: 0.6 for c in codes}, repeats=1, targets=50, past=past,
+                        tune=False)
     assert "engine" in row["time_s"]
     if "rebound" in codes:
         assert "rebound" not in row["time_s"] and "predicted" in row["notes"]["rebound"]
@@ -224,7 +242,7 @@ def test_targets_are_judged_from_the_figures():
 def measured():
     sizes = {"error_n": 1500, "compare_n": (1000, 2000), "scaling_n": (1000, 2000),
              "crossover_n": (256, 512), "memory_n": 1_000_000, "targets": 100, "repeats": 1,
-             "codes": ("engine", "rebound")}
+             "codes": ("engine", "engine_tree", "rebound")}
     return tb.measure(sizes)
 
 
@@ -232,7 +250,7 @@ def test_measure_gives_every_part_of_the_section(measured):
     t = measured
     assert t["skipped"]["pytreegrav"] == "not run at this level"
     codes = list(t["labels"])
-    assert "engine" in codes
+    assert "engine" in codes and "engine_tree" in codes
     for code in codes:
         curve = t["error"]["curves"][code]
         assert len(curve["rows"]) >= len(tb.THETAS)
@@ -268,6 +286,6 @@ def test_report_section_and_plots(measured, tmp_path):
         assert (tmp_path / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
         assert (tmp_path / name).stat().st_size > 10_000
     md = report.section_tree(measured, "e.png", "t.png")
-    assert md.startswith("## 6. Barnes-Hut tree")
+    assert md.startswith("## 6. Tree gravity")
     assert "](e.png)" in md and "](t.png)" in md and "**Findings.**" in md
     assert "tree" in report.SECTIONS and "tree_time.png" in report.output_files()
