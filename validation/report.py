@@ -100,7 +100,8 @@ def collect(level, workers=2, progress=True, sections=SECTIONS, scheduler=None):
     if "tree" in sections:  # timed: alone in this process, after everything else
         t_c = time.perf_counter()
         say = (lambda text: print(f"tree: {text}", file=sys.stderr)) if progress else None
-        out["tree"] = tree_bench.measure(tree_bench.SIZES[level.name], progress=say)
+        out["tree"] = tree_bench.measure(tree_bench.SIZES[level.name], progress=say,
+                                         energy_spec=tree_bench.ENERGY[level.name])
         phase_c = time.perf_counter() - t_c
     out["timings"] = {"wall_s": time.perf_counter() - t_start, "untimed_phase_wall_s": phase_a,
                       "timed_phase_wall_s": phase_b, "tree_phase_wall_s": phase_c}
@@ -979,6 +980,9 @@ def section_tree(sec, fig_error, fig_time):
     lines.append("")
     lines += tree_bench.markdown_tree(sec)
     lines.append("")
+    if "energy" in sec:
+        lines += tree_bench.markdown_energy(sec["energy"])
+        lines.append("")
     lines.append(tree_findings(sec))
     lines.append("")
     return "\n".join(lines)
@@ -1001,6 +1005,15 @@ def tree_findings(sec):
         parts.append(f"At N = {big['n']:.0e} and equal median error, the engine FMM's "
                      f"speed-up (the other code's time over the engine's; below 1x the engine "
                      f"is slower): {cells}.")
+    e = sec.get("energy")
+    if e:
+        fmm, direct = e["fmm"], e["direct"]
+        parts.append(
+            f"Over {fmm['steps']} leapfrog steps of a {e['n']}-body Plummer sphere the FMM's "
+            f"largest energy error is {f(max(abs(x) for x in fmm['dE']))} against the direct "
+            f"sum's {f(max(abs(x) for x in direct['dE']))} over its {direct['steps']}; the "
+            f"FMM's momentum drifts to {f(max(fmm['dP']))} of sum m|v| (its forces are not "
+            f"antisymmetric pair by pair), the direct sum's to {f(max(direct['dP']))}.")
     for name, measured, met in tree_bench.targets(sec):
         parts.append(f"Target: {name}: {measured}, {'met' if met else 'not met'}.")
     return "**Findings.** " + " ".join(parts)

@@ -483,9 +483,108 @@ def crossover(sizes, theta, repeats, seed=0):
             "below_range": tree_s[0] < direct_s[0]}
 
 
+# -- energy over a run -----------------------------------------------------------------------
+#: the energy runs of the report's levels: a Plummer sphere of n bodies (softening
+#: ``ENERGY_SOFTENING``), leapfrog at dt = ``ENERGY_DT``; the FMM for ``steps`` steps, the energy
+#: measured every ``every``; the direct sum beside it for ``direct_steps`` (every
+#: ``direct_every``): at 10^5 bodies a direct step takes seconds
+ENERGY = {"full": {"n": 100_000, "steps": 1000, "every": 200, "direct_steps": 30,
+                   "direct_every": 10},
+          "quick": {"n": 10_000, "steps": 1000, "every": 100, "direct_steps": 200,
+                    "direct_every": 50},
+          "smoke": {"n": 1000, "steps": 40, "every": 10, "direct_steps": 20,
+                    "direct_every": 10}}
+ENERGY_SOFTENING = 0.01
+#: 1/1250 of the sphere's crossing time G M^(5/2) / (2|E|)^(3/2) = 6.3
+ENERGY_DT = 0.005
+
+
+@jit(parallel=True, fastmath={"reassoc", "contract", "nsz", "arcp"}, error_model="numpy")
+def _pair_potentials(pos, mass, eps2, out):
+    """out[i] = -sum over j > i of m_i m_j / sqrt(r_ij^2 + eps^2) (G = 1), every pair once,
+    float64; rows in parallel, each row's sum vectorised."""
+    n = pos.shape[0]
+    for i in prange(n):
+        s = 0.0
+        for j in range(i + 1, n):
+            dx = pos[j, 0] - pos[i, 0]
+            dy = pos[j, 1] - pos[i, 1]
+            dz = pos[j, 2] - pos[i, 2]
+            s += mass[j] / math.sqrt(dx * dx + dy * dy + dz * dz + eps2)
+        out[i] = -mass[i] * s
+
+
+def exact_energy(pos, vel, mass, softening):
+    """Kinetic plus the softened potential energy of every pair (G = 1), summed exactly: the
+    same bits at any thread count (each row's sum is made by one thread, the rows summed by
+    numpy)."""
+    rows = np.empty(mass.shape[0])
+    _pair_potentials(np.ascontiguousarray(pos, dtype=np.float64),
+                     np.ascontiguousarray(mass, dtype=np.float64), float(softening) ** 2, rows)
+    return float(0.5 * np.sum(mass * np.sum(vel * vel, axis=1)) + rows.sum())
+
+
+def energy_run(n, steps, every, method, theta, seed=3):
+    """|dE/E| and |dP| / sum m|v| every ``every`` steps of a leapfrog run of an n-body Plummer
+    sphere under ``NBodyGravity(method=method, theta=theta)``; the energy of each state by
+    ``exact_energy`` (every pair), so that a tree's error in its own potential does not hide
+    the run's. {t, dE, dP, growth (the fitted dE/E per unit time), seconds (the stepping alone)}."""
+    from engine import Simulation, forces
+    from engine import initial_conditions as ic
+
+    bodies = ic.plummer(n, 3, seed=seed)
+    sim = Simulation(dim=3, integrator="leapfrog", dt=ENERGY_DT, G=1.0, capacity=n)
+    ic.add_to(sim, bodies)
+    sim.add_force(forces.NBodyGravity(softening=ENERGY_SOFTENING, method=method, theta=theta))
+    scale = float(np.sum(bodies.mass * np.linalg.norm(bodies.vel, axis=1)))
+
+    def energy_now():
+        return exact_energy(sim.pos, sim.vel, sim.mass, ENERGY_SOFTENING)
+
+    e0, p0 = energy_now(), sim.momentum()
+    out = {"t": [], "dE": [], "dP": []}
+    seconds = 0.0
+    for _ in range(steps // every):
+        seconds += _timed(lambda: sim.step(every))
+        out["t"].append(float(sim.t))
+        out["dE"].append(float((energy_now() - e0) / abs(e0)))
+        out["dP"].append(float(np.linalg.norm(sim.momentum() - p0) / scale))
+    out["growth"] = (float(np.polyfit(out["t"], out["dE"], 1)[0]) if len(out["t"]) > 1
+                     else None)
+    out["seconds"] = seconds
+    out["steps"] = steps
+    return out
+
+
+def energy(spec, theta):
+    """The FMM's run and the direct sum's beside it (``ENERGY``'s ``spec``)."""
+    return {"n": spec["n"], "dt": ENERGY_DT, "softening": ENERGY_SOFTENING, "theta": theta,
+            "fmm": energy_run(spec["n"], spec["steps"], spec["every"], "fmm", theta),
+            "direct": energy_run(spec["n"], spec["direct_steps"], spec["direct_every"],
+                                 "direct", theta)}
+
+
+def markdown_energy(e):
+    """Markdown lines of an energy comparison."""
+    out = [f"Energy over a run: a Plummer sphere of {e['n']} bodies (softening "
+           f"{e['softening']:g}), leapfrog at dt = {e['dt']:g}, the FMM at theta = "
+           f"{e['theta']:.3f} and the direct sum beside it (fewer steps: its steps cost "
+           "N^2); the energy of each state by the direct sum.", "",
+           "| run | steps | largest abs(dE/E) | fitted dE/E per unit time | largest abs(dP) / "
+           "sum m abs(v) | stepping s |", "|---|---|---|---|---|---|"]
+    for name in ("fmm", "direct"):
+        r = e[name]
+        growth = "—" if r["growth"] is None else f"{r['growth']:.2e}"
+        out.append(f"| {'FMM' if name == 'fmm' else 'direct sum'} | {r['steps']} | "
+                   f"{max(abs(x) for x in r['dE']):.2e} | {growth} | "
+                   f"{max(r['dP']):.2e} | {r['seconds']:.3g} |")
+    return out
+
+
 # -- the section ------------------------------------------------------------------------------
-def measure(sizes, progress=None):
-    """The whole section at ``sizes`` (one of ``SIZES``'s values): a JSON-ready dict."""
+def measure(sizes, progress=None, energy_spec=None):
+    """The whole section at ``sizes`` (one of ``SIZES``'s values): a JSON-ready dict; with
+    ``energy_spec`` (one of ``ENERGY``'s values) also the energy runs."""
     import numba
 
     say = progress or (lambda text: None)
@@ -531,6 +630,9 @@ def measure(sizes, progress=None):
         out["crossover"] = crossover(sizes["crossover_n"], thetas["engine"], sizes["repeats"])
     from engine.tree import layout
 
+    if energy_spec is not None and thetas.get("engine") is not None:
+        say(f"energy over a run: N = {energy_spec['n']}")
+        out["energy"] = energy(energy_spec, thetas["engine"])
     out["memory"] = {"n": sizes["memory_n"],
                      "bytes_per_particle": float(layout.bytes_per_particle(sizes["memory_n"])),
                      "threads": int(layout.THREADS)}

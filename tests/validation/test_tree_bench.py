@@ -243,7 +243,23 @@ def measured():
     sizes = {"error_n": 1500, "compare_n": (1000, 2000), "scaling_n": (1000, 2000),
              "crossover_n": (256, 512), "memory_n": 1_000_000, "targets": 100, "repeats": 1,
              "codes": ("engine", "engine_tree", "rebound")}
-    return tb.measure(sizes)
+    return tb.measure(sizes, energy_spec=tb.ENERGY["smoke"])
+
+
+def test_the_energy_runs_are_measured_beside_the_direct_sum(measured):
+    """The report's energy comparison at smoke size: the FMM's run and the direct sum's, each
+    with its energy error (by the direct sum of each state), momentum drift and growth; the
+    direct sum keeps momentum to round-off, the FMM does not."""
+    e = measured["energy"]
+    spec = tb.ENERGY["smoke"]
+    assert e["n"] == spec["n"] and e["theta"] == measured["theta_at_target"]["engine"]
+    assert len(e["fmm"]["dE"]) == spec["steps"] // spec["every"]
+    assert len(e["direct"]["dE"]) == spec["direct_steps"] // spec["direct_every"]
+    assert 0.0 < max(abs(x) for x in e["fmm"]["dE"]) < 1e-3
+    assert max(e["direct"]["dP"]) < 1e-13 < max(e["fmm"]["dP"])
+    lines = tb.markdown_energy(e)
+    assert sum(line.startswith("| FMM |") or line.startswith("| direct sum |")
+               for line in lines) == 2
 
 
 def test_measure_gives_every_part_of_the_section(measured):
