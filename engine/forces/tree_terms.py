@@ -64,11 +64,15 @@ def uses_tree(term, n):
     return method in ("tree", "fmm") or (method == "auto" and n >= DIRECT_BELOW)
 
 
+#: the packed code of the Barnes-Hut walk, read by compiled code
+BARNES_HUT = METHOD_CODES["tree"]
+
+
 @jit(error_model="numpy", inline="always")
 def multipole(code):
     """Does a tree term of packed method ``code`` walk by the fast multipole method ("fmm",
     and "auto" above its threshold) rather than Barnes-Hut's ("tree")?"""
-    return code != 1.0
+    return code != BARNES_HUT
 
 
 def check_owner(term, sim):

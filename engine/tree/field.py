@@ -75,12 +75,11 @@ def solve(pos, n, m, floats, ints, theta, eps2, order, potential, threads, multi
     parallel = threads and m >= THREADS_MIN
     if multipole and theta >= FMM_THETA_MIN:
         lanes = layout.lanes(floats, ints, n) if parallel else 1
-        local2 = theta * theta
         if parallel:
-            fmm.descend(floats, ints, n, m, theta * theta, local2, eps2, order, potential,
+            fmm.descend(floats, ints, n, m, theta * theta, eps2, order, potential,
                         small, fmm_group_size, lanes)
         else:
-            fmm.descend_serial(floats, ints, n, m, theta * theta, local2, eps2, order,
+            fmm.descend_serial(floats, ints, n, m, theta * theta, eps2, order,
                                potential, small, fmm_group_size, 1)
         if fmm.succeeded(ints, n, lanes):
             return ncell

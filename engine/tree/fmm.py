@@ -54,7 +54,7 @@ def is_group(c, count, children, group_size):
 
 @jit(error_model="numpy")
 def resolve(T, ws, we, loc, cand, deferred, px, py, pz, beta, ax, ay, az, phi, cells, start,
-            count, child, children, lx, ly, lz, lb, lc, ll, theta2, local2, eps2, order,
+            count, child, children, lx, ly, lz, lb, lc, ll, theta2, eps2, order,
             potential, small, group_size):
     """Resolve target cell T against the candidates cand[ws:we) (module doc), its expansion
     ``loc`` holding what its ancestors handed down. A group's targets get their sums; another
@@ -65,7 +65,7 @@ def resolve(T, ws, we, loc, cand, deferred, px, py, pz, beta, ax, ay, az, phi, c
     written out here: a shared function for it (inlined by numba, or not) made this walk 20%
     slower and its one-thread run 35% (measured at 10^6 bodies), so the two loops are kept
     alike by hand: a change to one is a change to the other."""
-    isgroup = children[T] == 0 or count[T] <= group_size
+    isgroup = is_group(T, count, children, group_size)
     zx = cells[mp.CX, T]
     zy = cells[mp.CY, T]
     zz = cells[mp.CZ, T]
@@ -115,7 +115,7 @@ def resolve(T, ws, we, loc, cand, deferred, px, py, pz, beta, ax, ay, az, phi, c
         radius = cells[mp.RADIUS, S]
         spread = radius + reach
         # separated: acts on T's expansion (the condition of ``walk.walk_group``)
-        if count[S] * count[T] > 4 * small and spread * spread < local2 * (rx * rx + ry * ry
+        if count[S] * count[T] > 4 * small and spread * spread < theta2 * (rx * rx + ry * ry
                                                                             + rz * rz):
             if nlocal == clist:
                 local.flush(ll, nlocal, zx, zy, zz, eps2, loc, potential)
@@ -184,7 +184,7 @@ def resolve(T, ws, we, loc, cand, deferred, px, py, pz, beta, ax, ay, az, phi, c
 
 
 @jit(error_model="numpy")
-def descend_lane(lane, lanes, floats, ints, n, m, theta2, local2, eps2, order, potential,
+def descend_lane(lane, lanes, floats, ints, n, m, theta2, eps2, order, potential,
                  small, group_size):
     """Lane ``lane``'s share of the walk (module doc): 0, or -1 if its scratch ran out."""
     part = layout.particle_blocks(floats, n)
@@ -203,7 +203,7 @@ def descend_lane(lane, lanes, floats, ints, n, m, theta2, local2, eps2, order, p
         floc[0, k] = 0.0
     cand[0] = 0  # the root's one candidate: itself
     ndef = resolve(0, 0, 1, floc[0], cand, deferred, px, py, pz, beta, ax, ay, az, phi, cells,
-                   start, count, child, children, lx, ly, lz, lb, lc, ll, theta2, local2,
+                   start, count, child, children, lx, ly, lz, lb, lc, ll, theta2,
                    eps2, order, potential, small, group_size)
     if ndef < 0:
         return -1
@@ -239,7 +239,7 @@ def descend_lane(lane, lanes, floats, ints, n, m, theta2, local2, eps2, order, p
                           potential)
         ndef = resolve(k, ws, ws + size, floc[depth + 1], cand, deferred, px, py, pz, beta, ax,
                        ay, az, phi, cells, start, count, child, children, lx, ly, lz, lb, lc,
-                       ll, theta2, local2, eps2, order, potential, small, group_size)
+                       ll, theta2, eps2, order, potential, small, group_size)
         if ndef < 0:
             return -1
         depth += 1
@@ -251,28 +251,28 @@ def descend_lane(lane, lanes, floats, ints, n, m, theta2, local2, eps2, order, p
 
 
 #: one signature for both (see ``walk.SIGNATURE``)
-SIGNATURE = ("void(float64[::1], int64[::1], int64, int64, float64, float64, float64, int64, "
-             "boolean, int64, int64, int64)")
+SIGNATURE = ("void(float64[::1], int64[::1], int64, int64, float64, float64, int64, boolean, "
+             "int64, int64, int64)")
 
 
 @jit(signature=SIGNATURE, parallel=True, error_model="numpy")
-def descend(floats, ints, n, m, theta2, local2, eps2, order, potential, small, group_size,
+def descend(floats, ints, n, m, theta2, eps2, order, potential, small, group_size,
             lanes):
     """The walk on ``lanes`` lanes (module doc), each lane's outcome in its
     ``layout.lane_status``: 0, or -1 if its scratch ran out (its sums are then incomplete:
     walk again by ``walk``)."""
     for lane in prange(lanes):
         layout.lane_status(ints, n, lane)[0] = descend_lane(
-            lane, lanes, floats, ints, n, m, theta2, local2, eps2, order, potential, small,
+            lane, lanes, floats, ints, n, m, theta2, eps2, order, potential, small,
             group_size)
 
 
 @jit(signature=SIGNATURE, error_model="numpy")
-def descend_serial(floats, ints, n, m, theta2, local2, eps2, order, potential, small,
+def descend_serial(floats, ints, n, m, theta2, eps2, order, potential, small,
                    group_size, lanes):
     """``descend`` on the calling thread, as lane 0 of 1."""
     layout.lane_status(ints, n, 0)[0] = descend_lane(0, 1, floats, ints, n, m, theta2,
-                                                     local2, eps2, order, potential, small,
+                                                     eps2, order, potential, small,
                                                      group_size)
 
 

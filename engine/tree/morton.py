@@ -102,9 +102,8 @@ def keys(pos, slots, m, out):
 
 
 @jit(error_model="numpy", inline="always")
-def range_keys(px, py, pz, s, e, dim, out):
-    """out[k] = the key of sorted particle k in [s, e), in the bounding cube of those
-    particles alone; False (nothing written) if they all coincide."""
+def range_box(px, py, pz, s, e):
+    """(lo x, y, z, hi x, y, z): the bounding box of sorted particles [s, e)."""
     lx = hx = px[s]
     ly = hy = py[s]
     lz = hz = pz[s]
@@ -115,6 +114,14 @@ def range_keys(px, py, pz, s, e, dim, out):
         hy = max(hy, py[k])
         lz = min(lz, pz[k])
         hz = max(hz, pz[k])
+    return lx, ly, lz, hx, hy, hz
+
+
+@jit(error_model="numpy", inline="always")
+def range_keys(px, py, pz, s, e, dim, out):
+    """out[k] = the key of sorted particle k in [s, e), in the bounding cube of those
+    particles alone; False (nothing written) if they all coincide."""
+    lx, ly, lz, hx, hy, hz = range_box(px, py, pz, s, e)
     side = max(hx - lx, hy - ly, hz - lz)
     if not side > 0.0:
         return False

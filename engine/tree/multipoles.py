@@ -36,6 +36,8 @@ import math
 
 from ..cache import jit
 
+from . import morton
+
 # rows of the cell table (``layout.CELL_FLOATS`` of them)
 CX, CY, CZ = 0, 1, 2
 M, DX, DY, DZ = 3, 4, 5, 6
@@ -53,16 +55,7 @@ ORDERS = (0, 1, 2)
 def leaf_box(px, py, pz, s, e, cells, c):
     """The bounding box of particles [s, e), its centre, largest side and half diagonal (the
     cell's centre and radius until ``leaf_moments`` sets them)."""
-    lx = hx = px[s]
-    ly = hy = py[s]
-    lz = hz = pz[s]
-    for k in range(s + 1, e):
-        lx = min(lx, px[k])
-        hx = max(hx, px[k])
-        ly = min(ly, py[k])
-        hy = max(hy, py[k])
-        lz = min(lz, pz[k])
-        hz = max(hz, pz[k])
+    lx, ly, lz, hx, hy, hz = morton.range_box(px, py, pz, s, e)
     set_box(cells, c, lx, ly, lz, hx, hy, hz)
 
 
