@@ -42,7 +42,7 @@ from ._validate import (finite_float, int_in_range, nonnegative_float, positive_
 from .errors import SimulationError
 from .forces.base import DeclaresTerms
 from .forces.dispatch import pack, potential_terms
-from .forces.pairwise import PARALLEL_MIN
+from .forces.pairwise import PARALLEL_MIN, float_count
 from .integrators import dormand_prince, euler, runge_kutta, splitting
 from .integrators.common import STEP_COLLAPSED, TIME_OVERFLOW
 from .space import check_box
@@ -97,7 +97,7 @@ def step_system(m, family, t, h, steps, state, model, work, vdep, tol, drifts, k
 def _workspace(n):
     """The scratch a ``Simulation`` of n slots would get, kept on this thread."""
     if n >= PARALLEL_MIN:
-        return Workspace(np.empty(8 * n), np.empty(n, dtype=np.int64), False)
+        return Workspace(np.empty(float_count(n)), np.empty(n, dtype=np.int64), False)
     return Workspace(np.empty(0), np.empty(0, dtype=np.int64), False)
 
 

@@ -94,8 +94,73 @@ def test_large_n_momentum_and_determinism():
     a, p0 = run()
     b, _ = run()
     assert a.pos.tobytes() == b.pos.tobytes()
-    # each pair is summed from both ends separately, so momentum holds to round-off only
+    # each pair is evaluated once, but its two sides are scaled by different masses, so
+    # momentum holds to round-off only
     np.testing.assert_allclose(a.momentum(), p0, atol=1e-11 * a.mass.sum())
+
+
+#: particle counts around the kernel's edges: fewer sources than a four, counts that are not a
+#: multiple of four, the first sizes on all cores, and where the chunks' rows move
+AWKWARD = [pairwise.PARALLEL_MIN, pairwise.PARALLEL_MIN + 1, pairwise.PARALLEL_MIN + 3, 31,
+           pairwise.THREADS_MIN, pairwise.THREADS_MIN + 1, pairwise.THREADS_MIN + 3, 517]
+
+
+@pytest.mark.parametrize("n", AWKWARD)
+def test_each_pair_once_matches_a_direct_sum_at_awkward_sizes(n):
+    rng = np.random.default_rng(n)
+    test = np.zeros(n, dtype=bool)
+    test[rng.choice(n, min(n - 2, 9), replace=False)] = True  # as few as 2 sources
+    sim = Simulation(dim=3)
+    sim.add_many(mass=rng.uniform(0.5, 2.0, n), pos=rng.normal(size=(n, 3)), test=test)
+    sim.add_force(forces.NBodyGravity(G=1.3, softening=0.02))
+    a = accel(sim)
+    sources = np.flatnonzero(~test)
+    expected = numpy_field(sim.pos, 1.3 * sim.mass, 4e-4, range(n), sources)
+    np.testing.assert_allclose(a, expected, rtol=1e-11, atol=1e-12 * np.abs(expected).max())
+
+
+def test_each_pair_once_gives_equal_and_opposite_forces():
+    """Without test particles, the sum of m_i a_i over all bodies is zero to round-off of the
+    forces' size (each pair's two sides come from one evaluation of d / r^3)."""
+    rng = np.random.default_rng(12)
+    n = 300
+    sim = Simulation(dim=3)
+    sim.add_many(mass=rng.uniform(0.5, 2.0, n), pos=rng.normal(size=(n, 3)))
+    sim.add_force(forces.NBodyGravity(softening=0.01))
+    force = sim.mass[:, None] * accel(sim)
+    assert np.abs(force.sum(axis=0)).max() < 1e-13 * np.abs(force).sum()
+
+
+@pytest.mark.parametrize("precision", ["float64", "float32"])
+def test_the_pair_sum_is_the_same_to_the_bit_on_one_thread_and_on_all(precision):
+    import numba
+
+    rng = np.random.default_rng(21)
+    n = pairwise.THREADS_MIN + 301
+    sim = Simulation(dim=3)
+    sim.add_many(mass=rng.uniform(0.5, 2.0, n), pos=rng.normal(size=(n, 3)),
+                 test=rng.random(n) < 0.1)
+    sim.add_force(forces.NBodyGravity(softening=0.01, precision=precision))
+    threads = numba.get_num_threads()
+    fields = []
+    try:
+        for count in (1, threads):
+            numba.set_num_threads(count)
+            fields.append(accel(sim))
+    finally:
+        numba.set_num_threads(threads)
+    assert fields[0].tobytes() == fields[1].tobytes()
+
+
+def test_the_tree_workspace_is_large_enough_for_the_direct_kernels():
+    """A scene with a tree term hands the tree's workspace to every term, direct ones too: the
+    direct kernels must find room in it at every size, or they would fall back to the scalar
+    loop (correct, five times slower)."""
+    from engine.tree import layout
+
+    sizes = list(range(pairwise.PARALLEL_MIN, 5000, 37)) + [10 ** 5, 10 ** 6, 10 ** 7]
+    short = [n for n in sizes if layout.float_count(n, layout.THREADS) < pairwise.float_count(n)]
+    assert short == []
 
 
 def test_large_n_coincident_bodies_still_fail_loudly():
