@@ -13,7 +13,8 @@ from . import initial_conditions, stability
 from .batch import Batch
 from .atomic import OutputPathError, atomic_write, check_output_dir, check_output_path
 from .clock import FixedStepClock
-from .errors import SimulationError
+from .collisions import Collisions, Contact, Wall, box_walls
+from .errors import Collision, SimulationError
 from .integrators import ADAPTIVE_INTEGRATORS, INTEGRATORS, ORDERS, SYMPLECTIC
 from .simulation import Simulation
 from . import advisor
@@ -24,4 +25,5 @@ __version__ = "0.1.0"
 __all__ = ["Simulation", "Batch", "space", "state", "SimulationError", "INTEGRATORS", "ADAPTIVE_INTEGRATORS", "ORDERS", "SYMPLECTIC", "forces", "integrators",
            "analytic", "clock", "diagnostics", "stability", "FixedStepClock", "__version__", "atomic",
            "atomic_write", "check_output_path", "check_output_dir", "OutputPathError", "advise",
-           "advisor", "initial_conditions"]
+           "advisor", "initial_conditions", "Collisions", "Collision", "Contact", "Wall",
+           "box_walls"]

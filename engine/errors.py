@@ -17,3 +17,21 @@ class SimulationError(RuntimeError):
         self.step = step
         self.time = time
         self.particle = particle
+
+
+class Collision(SimulationError):
+    """Two particles touched in a simulation whose collisions say ``resolve="halt"``.
+
+    A ``SimulationError`` (a step that could not be completed as asked), with the state left
+    as it was at the start of the step in which they touched; the contacts of the call before
+    that step stay in ``sim.contacts``. Besides ``step``, ``time`` (the time of contact, inside
+    that step) and ``particle`` (the pair's lower index), it carries:
+
+    - ``pair``: the two indices ``(i, j)``, ``i < j``;
+    - ``speed``: the normal component of their relative velocity as they touched.
+    """
+
+    def __init__(self, message, *, pair, time, speed, step=None):
+        super().__init__(message, step=step, time=time, particle=pair[0])
+        self.pair = pair
+        self.speed = speed

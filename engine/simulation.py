@@ -11,7 +11,7 @@ import numpy as np
 from . import diagnostics
 from . import integrators as _integrators
 from ._validate import MAX_STEPS, finite_float, nonnegative_float, positive_float, real_array, step_count
-from .errors import SimulationError
+from .errors import Collision, SimulationError
 from .forces.base import DeclaresTerms
 from .forces import tree_terms
 from .forces.dispatch import accelerations as _accelerations, pack, potential_terms
@@ -106,6 +106,11 @@ class Simulation(DeclaresTerms):
         # bumped by every add and remove of a force term: the packed model is keyed on it (a
         # key of the terms' id() would match a removed term's reused address)
         self._revision = 0
+        self._collisions = None  # engine.Collisions, or None: nothing touches
+        self._contacts = ()
+        #: the energy contacts took out (inelastic bounces, merges) since the simulation began:
+        #: ``sim.energy() + sim.energy_ledger`` is what contacts leave unchanged
+        self.energy_ledger = 0.0
         self.t = 0.0
         self.steps = 0
         #: force evaluations made so far: counted by rk45 (rejected attempts included) and
@@ -121,6 +126,29 @@ class Simulation(DeclaresTerms):
     @integrator.setter
     def integrator(self, name):
         self._integrator = _integrators.check_name(name)
+
+    @property
+    def collisions(self):
+        """How particles' spheres meet: an ``engine.Collisions``, or None (the default:
+        particles pass through each other, and no contact code is compiled or run)."""
+        return self._collisions
+
+    @collisions.setter
+    def collisions(self, value):
+        from .collisions import Collisions
+
+        if value is not None and not isinstance(value, Collisions):
+            raise TypeError(f"collisions must be an engine.Collisions or None, got {value!r}")
+        if value is not None:
+            value.wall_arrays(self.dim)  # walls of another dimension: refused now
+        self._collisions = value
+
+    @property
+    def contacts(self):
+        """The contacts resolved by the last ``step``/``integrate`` call, in the order they
+        happened: a tuple of ``engine.Contact`` (time, i, j, speed, action, energy,
+        survivor)."""
+        return self._contacts
 
     @property
     def dt(self):
@@ -486,6 +514,7 @@ class Simulation(DeclaresTerms):
         ``n`` is an int in ``[0, 2**62]`` (bools and floats are refused).
         """
         n = step_count("n", n)
+        self._contacts = ()
         if n:
             self._run(self._dt, n, math.nan)
 
@@ -497,6 +526,7 @@ class Simulation(DeclaresTerms):
         ``t_end`` must be finite and (fixed-step methods) reachable in at most 2**62 steps.
         """
         t_end = finite_float("t_end", self._code(t_end, "time", "t_end"))
+        self._contacts = ()
         remaining = t_end - self._t
         if remaining == 0.0:
             return
@@ -525,6 +555,75 @@ class Simulation(DeclaresTerms):
         self._t = t_end
 
     def _run(self, h, steps, t_end, keep_dt=False):
+        if self._collisions is not None:
+            self._run_colliding(h, steps, t_end, keep_dt)
+        else:
+            self._advance(h, steps, t_end, keep_dt)
+
+    def _run_colliding(self, h, steps, t_end, keep_dt):
+        """``steps`` steps (or up to ``t_end``), each followed by its contacts
+        (``engine.collisions.events``): the integrator takes a step, then the contacts along
+        the bodies' paths over it are found and resolved in time order."""
+        from numba import types
+        from numba.typed import List
+
+        from .collisions import events
+        from .collisions.settings import ACTIONS, RESOLVE_CODES, SEARCH_CODES, Contact
+
+        settings = self._collisions
+        if self._integrator == "janus":
+            raise ValueError("janus cannot take collisions: it is exactly reversible and a "
+                             "contact is not (set sim.collisions = None, or use another "
+                             "integrator); nothing was changed")
+        points, normals = settings.wall_arrays(self.dim)
+        adaptive = self._integrator in _integrators.ADAPTIVE_INTEGRATORS
+        record = List.empty_list(types.UniTuple(types.float64, 7))
+
+        def publish():
+            new = tuple(Contact(t, int(i), int(j), speed, ACTIONS[int(a)], energy,
+                                int(keep) if keep >= 0 else None)
+                        for t, i, j, speed, a, energy, keep in record)
+            self._contacts += new
+            self.energy_ledger += float(sum(c.energy for c in new))
+
+        state, model = self.kernel_arguments()
+        for _ in range(steps):
+            if adaptive and not math.isnan(t_end) and self._t == t_end:
+                break
+            n = state.n
+            p0 = state.pos[:, :n].copy()
+            v0 = state.vel[:, :n].copy()
+            t_before, steps_before = self._t, self.steps
+            # an adaptive method starts each step from the step size it chose last
+            self._advance(math.copysign(abs(self._dt), h) if adaptive else h, 1, t_end,
+                          keep_dt)
+            state, model = self.kernel_arguments()
+            status, pair, t_hit, speed = events.collide(
+                t_before, self._t - t_before, state, model, p0, v0,
+                RESOLVE_CODES[settings.resolve], settings.restitution, points, normals,
+                SEARCH_CODES[settings.search], record)
+            if status == events.DONE:
+                continue
+            state.pos[:, :n] = p0
+            state.vel[:, :n] = v0
+            self._t, self.steps = t_before, steps_before
+            publish()
+            if status == events.HALTED:
+                i, j = divmod(int(pair), n)
+                raise Collision(
+                    f"particles {i} and {j} touched at t={t_hit!r} (normal speed {speed!r}) in "
+                    f"step {steps_before} from t={t_before!r}, and collisions say "
+                    f"resolve='halt'; the state is left at the start of that step",
+                    pair=(i, j), time=t_hit, speed=speed, step=steps_before)
+            raise SimulationError(
+                f"more than {events.CONTACTS_PER_PARTICLE} contacts per particle in step "
+                f"{steps_before} from t={t_before!r}: an inelastic collapse (restitution "
+                f"{settings.restitution!r} < 1 can give endless contacts in a finite time); "
+                "use a smaller dt or a restitution nearer 1; the state is left at the start of "
+                "that step", step=steps_before, time=t_before, particle=None)
+        publish()
+
+    def _advance(self, h, steps, t_end, keep_dt=False):
         adaptive = self._integrator in _integrators.ADAPTIVE_INTEGRATORS
         if not adaptive and not math.isfinite(self._t + steps * h):
             raise ValueError(f"{steps} steps of {h!r} from t={self._t!r} take the time past the "
