@@ -384,6 +384,17 @@ class Batch(DeclaresTerms):
     # -- forces ----------------------------------------------------------------------
     _owner = "batch"
 
+    def add_force(self, force):
+        """Declare a force term for every system (``Simulation.add_force``); springs that
+        yield or break are refused (a batch does not run their after-step pass yet)."""
+        from .forces.springs import Springs
+
+        if isinstance(force, Springs) and force.plastic:
+            raise ValueError(f"{force!r} yields or breaks (yield_strain or break_strain set): "
+                             "a Batch does not take plastic springs yet; use a Simulation "
+                             "per system")
+        return super().add_force(force)
+
     def _forgotten(self, force):
         self._per_system = [(t, name) for t, name in self._per_system if t is not force]
 

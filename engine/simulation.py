@@ -16,6 +16,7 @@ from .forces.base import DeclaresTerms
 from .forces import tree_terms
 from .forces.dispatch import accelerations as _accelerations, pack, potential_terms
 from .forces.pairwise import workspace as _pair_workspace
+from .forces.springs import Springs
 from .integrators import direct
 from .integrators import ias15 as _ias15
 from .integrators import janus as _janus
@@ -555,27 +556,34 @@ class Simulation(DeclaresTerms):
         self._t = t_end
 
     def _run(self, h, steps, t_end, keep_dt=False):
-        if self._collisions is not None:
-            self._run_colliding(h, steps, t_end, keep_dt)
+        plastic = [(s, f) for s, f in enumerate(self._forces)
+                   if isinstance(f, Springs) and f.plastic]
+        if self._collisions is not None or plastic:
+            self._run_with_contact(h, steps, t_end, keep_dt, plastic)
         else:
             self._advance(h, steps, t_end, keep_dt)
 
-    def _run_colliding(self, h, steps, t_end, keep_dt):
+    def _run_with_contact(self, h, steps, t_end, keep_dt, plastic):
         """``steps`` steps (or up to ``t_end``), each followed by its contacts
-        (``engine.collisions.events``): the integrator takes a step, then the contacts along
-        the bodies' paths over it are found and resolved in time order."""
+        (``engine.collisions.events``) and by the yielding and breaking of plastic springs
+        (``engine.forces.spring_yield``): the integrator takes a step, then the contacts along
+        the bodies' paths over it are found and resolved in time order, then the springs."""
         from numba import types
         from numba.typed import List
 
-        from .collisions import events
         from .collisions.settings import ACTIONS, RESOLVE_CODES, SEARCH_CODES, Contact
 
         settings = self._collisions
         if self._integrator == "janus":
-            raise ValueError("janus cannot take collisions: it is exactly reversible and a "
-                             "contact is not (set sim.collisions = None, or use another "
-                             "integrator); nothing was changed")
-        points, normals = settings.wall_arrays(self.dim)
+            raise ValueError("janus cannot take collisions or yielding springs: it is exactly "
+                             "reversible and a contact is not (set sim.collisions = None and "
+                             "yield_strain = break_strain = None, or use another integrator); "
+                             "nothing was changed")
+        if settings is not None:
+            from .collisions import events
+            points, normals = settings.wall_arrays(self.dim)
+        if plastic:
+            from .forces import spring_yield
         adaptive = self._integrator in _integrators.ADAPTIVE_INTEGRATORS
         record = List.empty_list(types.UniTuple(types.float64, 7))
 
@@ -594,19 +602,41 @@ class Simulation(DeclaresTerms):
             p0 = state.pos[:, :n].copy()
             v0 = state.vel[:, :n].copy()
             t_before, steps_before = self._t, self.steps
+            mark = len(record)
+            merging = settings is not None and settings.resolve == "merge"
+            if merging:  # a merge changes these: kept to restore a step that fails
+                kept = [getattr(state, f)[:n].copy() for f in ("mass", "charge", "radius",
+                                                              "active")]
             # an adaptive method starts each step from the step size it chose last
             self._advance(math.copysign(abs(self._dt), h) if adaptive else h, 1, t_end,
                           keep_dt)
             state, model = self.kernel_arguments()
-            status, pair, t_hit, speed = events.collide(
-                t_before, self._t - t_before, state, model, p0, v0,
-                RESOLVE_CODES[settings.resolve], settings.restitution, points, normals,
-                SEARCH_CODES[settings.search], record)
-            if status == events.DONE:
+            taken = self._t - t_before
+            status = 0
+            if settings is not None:
+                status, pair, t_hit, speed = events.collide(
+                    t_before, taken, state, model, p0, v0, RESOLVE_CODES[settings.resolve],
+                    settings.restitution, points, normals, SEARCH_CODES[settings.search],
+                    record)
+            if status == 0:
+                for s, term in plastic:
+                    f0, m = int(model.param_offsets[s]), len(term)
+                    i0 = int(model.index_offsets[s])
+                    self.energy_ledger += spring_yield.yield_and_break(
+                        self._t, taken, state.pos, state.vel, state.active, state.box,
+                        model.indices[i0:i0 + 2 * m], model.params, f0, m, term.yield_strain,
+                        term.break_strain, term.flow_rate, record)
+                    term._after_step(model.params[f0 + m:f0 + 2 * m], model.params[f0:f0 + m],
+                                     model.params[f0 + 2 * m:f0 + 3 * m])
                 continue
             state.pos[:, :n] = p0
             state.vel[:, :n] = v0
+            if merging:
+                for f, values in zip(("mass", "charge", "radius", "active"), kept):
+                    getattr(state, f)[:n] = values
             self._t, self.steps = t_before, steps_before
+            while len(record) > mark:  # the failed step's contacts did not happen
+                record.pop()
             publish()
             if status == events.HALTED:
                 i, j = divmod(int(pair), n)

@@ -28,7 +28,7 @@ RESOLVE_CODES = {name: k for k, name in enumerate(RESOLVE)}
 SEARCH_CODES = {name: k for k, name in enumerate(SEARCH)}
 
 #: what a contact record says was done (``Contact.action``), by the kernels' code
-ACTIONS = ("bounce", "merge", "wall")
+ACTIONS = ("bounce", "merge", "wall", "break")
 
 Contact = namedtuple("Contact", "time i j speed action energy survivor")
 Contact.__doc__ = """One contact resolved during a ``step``/``integrate`` call.
@@ -38,7 +38,9 @@ Contact.__doc__ = """One contact resolved during a ``step``/``integrate`` call.
   index in ``collisions.walls``;
 - ``speed``: the speed at which they met: for a bounce or a wall, the normal component of
   the relative velocity (> 0); for a merge, the whole relative speed;
-- ``action``: ``"bounce"``, ``"merge"`` or ``"wall"``;
+- ``action``: ``"bounce"``, ``"merge"``, ``"wall"``, or ``"break"`` (a spring broke:
+  ``engine.forces.spring_yield``; ``i``, ``j`` its particles, ``speed`` the rate at which it
+  was stretching, ``time`` the end of the step);
 - ``energy``: the energy the contact took out of the system (``sim.energy_ledger`` gains it):
   (1 - e^2) mu v_n^2 / 2 for a bounce of restitution e; for a merge, the total energy of the
   state before it less after it (kinetic and the declared terms' potential);

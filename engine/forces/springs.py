@@ -10,6 +10,11 @@ but not rigid rotation).     U = sum 1/2 k (r - l)^2  (the damping part is not c
 k, l and c may be scalars or one value per spring. A zero-length spring (l = 0) is linear,
 f_a = k d, and is well defined even with a and b coincident; a spring with l > 0 whose ends
 coincide has no direction and makes the step fail loudly.
+
+``yield_strain``, ``break_strain`` and ``flow_rate`` make springs plastic and breakable
+(``engine.forces.spring_yield``: after each step, past the yield strain the rest length flows
+towards the current length at ``flow_rate`` per unit time; past the break strain the spring
+breaks). Strains are measured against the current rest length.
 """
 import math
 
@@ -17,7 +22,7 @@ import numpy as np
 from ..cache import jit
 
 from ._kernels import add_force, delta, delta_periodic
-from .base import Force
+from .base import Force, _read_only
 from .._validate import index_array, per_item, vector, positive_float, nonnegative_float
 
 KIND = 4
@@ -83,7 +88,8 @@ class Springs(Force):
     BOUNDS = {"k": (0.0, False), "rest_length": (0.0, False), "damping": (0.0, False)}
     conservative = True
 
-    def __init__(self, pairs, k=10.0, rest_length=1.0, damping=0.0):
+    def __init__(self, pairs, k=10.0, rest_length=1.0, damping=0.0, yield_strain=None,
+                 break_strain=None, flow_rate=1.0):
         super().__init__()
         arr = index_array("pairs", pairs, 2)
         if arr.ndim != 2 or arr.shape[1] != 2:
@@ -96,6 +102,45 @@ class Springs(Force):
         self.k = per_item("k", k, count, minimum=0.0)
         self.rest_length = per_item("rest_length", rest_length, count, minimum=0.0)
         self.damping = per_item("damping", damping, count, minimum=0.0)
+        limits = {}
+        for name, value in (("yield_strain", yield_strain), ("break_strain", break_strain)):
+            limits[name] = np.full(count, np.inf) if value is None else \
+                per_item(name, value, count, minimum=0.0, strictly=True)
+        rate = per_item("flow_rate", flow_rate, count, minimum=0.0)
+        crossed = np.isfinite(limits["yield_strain"]) & \
+            (limits["yield_strain"] >= limits["break_strain"])
+        if np.any(crossed):
+            bad = int(np.flatnonzero(crossed)[0])
+            raise ValueError(f"yield_strain must be below break_strain, got yield_strain "
+                             f"{float(limits['yield_strain'][bad])!r} and break_strain "
+                             f"{float(limits['break_strain'][bad])!r} (spring {bad})")
+        plastic = np.isfinite(limits["yield_strain"]) | np.isfinite(limits["break_strain"])
+        if np.any(plastic & (self.rest_length == 0.0)):
+            bad = int(np.flatnonzero(plastic & (self.rest_length == 0.0))[0])
+            raise ValueError(f"rest_length[{bad}] = 0.0: a zero-length spring has no strain, so "
+                             "it cannot yield or break (give it yield_strain=None, "
+                             "break_strain=None)")
+        self.yield_strain = limits["yield_strain"]
+        self.break_strain = limits["break_strain"]
+        self.flow_rate = rate
+
+    @property
+    def plastic(self):
+        """Do any of these springs yield or break?"""
+        return bool(np.any(np.isfinite(self.yield_strain)) or
+                    np.any(np.isfinite(self.break_strain)))
+
+    @property
+    def broken(self):
+        """Which springs have broken (their stiffness is 0 for good), a bool per spring."""
+        return self.__dict__.get("_broken", np.zeros(len(self), dtype=bool)).copy()
+
+    def _after_step(self, rest_length, k, damping):
+        """The rest lengths, stiffnesses and damping a step's yielding and breaking left (the
+        packed model holds them already: no re-pack)."""
+        object.__setattr__(self, "_broken", self.broken | ((k == 0.0) & (self.k > 0.0)))
+        for name, value in (("rest_length", rest_length), ("k", k), ("damping", damping)):
+            object.__setattr__(self, name, _read_only(value.copy()))
 
     def __len__(self):
         return self.pairs.shape[0]
