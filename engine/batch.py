@@ -39,7 +39,7 @@ from . import diagnostics
 from . import integrators as _integrators
 from ._validate import (finite_float, int_in_range, nonnegative_float, positive_float, real_array,
                         step_count)
-from .errors import SimulationError
+from .errors import Collision, SimulationError
 from .forces.base import DeclaresTerms
 from .forces.dispatch import pack, potential_terms
 from .forces.pairwise import PARALLEL_MIN, float_count
@@ -194,6 +194,10 @@ class Batch(DeclaresTerms):
         self._layouts = {}
         self._layout_terms = []
         self._per_system = []  # (term, name) pairs set per system
+        self._collisions = None  # engine.Collisions, or None
+        self._contacts = tuple(() for _ in range(self.systems))
+        #: (M,) the energy contacts took out of each system (``Simulation.energy_ledger``)
+        self.energy_ledger = np.zeros(self.systems)
 
     # -- storage ---------------------------------------------------------------------
     def _allocate(self, capacity):
@@ -502,6 +506,58 @@ class Batch(DeclaresTerms):
                       self._test, self._pinned, self.n, self._box)
         return state, self._current_model()
 
+    # -- contact -----------------------------------------------------------------------
+    @property
+    def collisions(self):
+        """Every system's contacts (``engine.Collisions``, as ``Simulation.collisions``), or
+        None."""
+        return self._collisions
+
+    @collisions.setter
+    def collisions(self, value):
+        from .collisions import Collisions
+
+        if value is not None and not isinstance(value, Collisions):
+            raise TypeError(f"collisions must be an engine.Collisions or None, got {value!r}")
+        if value is not None:
+            value.wall_arrays(self.dim)
+        self._collisions = value
+
+    @property
+    def contacts(self):
+        """The last ``step`` call's contacts: one tuple of ``engine.Contact`` per system."""
+        return self._contacts
+
+    def _step_colliding(self, n, state, model, vdep, family, drifts, kicks, done, status):
+        """``advance_all`` with every step followed by its contacts
+        (``engine.collisions.batch_steps``); the contacts and the ledger published."""
+        from numba import types
+        from numba.typed import List
+
+        from .collisions import batch_steps
+        from .collisions.settings import ACTIONS, RESOLVE_CODES, SEARCH_CODES, Contact
+
+        settings = self._collisions
+        points, normals = settings.wall_arrays(self.dim)
+        record_type = types.UniTuple(types.float64, 7)
+        records = List.empty_list(types.ListType(record_type))
+        for _ in range(self.systems):
+            records.append(List.empty_list(record_type))
+        halts = np.zeros((self.systems, 3))
+        batch_steps.advance_all_colliding(
+            family, self._t, self._h, n, state, model, vdep, self._tolerance, drifts, kicks,
+            done, status, RESOLVE_CODES[settings.resolve], settings.restitution, points,
+            normals, SEARCH_CODES[settings.search], records, halts)
+        contacts = []
+        for m, record in enumerate(records):
+            mine = tuple(Contact(t, int(i), int(j), speed, ACTIONS[int(a)], energy,
+                                 int(keep) if keep >= 0 else None)
+                         for t, i, j, speed, a, energy, keep in record)
+            self.energy_ledger[m] += sum(c.energy for c in mine)
+            contacts.append(mine)
+        self._contacts = tuple(contacts)
+        return halts
+
     # -- time ------------------------------------------------------------------------
     def step(self, n=1):
         """Advance every system by ``n`` steps in one compiled call (rk45: ``n`` accepted
@@ -520,8 +576,14 @@ class Batch(DeclaresTerms):
         done = np.zeros(self.systems, dtype=np.int64)
         status = np.full(self.systems, -1, dtype=np.int64)
         h_before = self._h.copy()
-        advance_all(family, self._t, self._h, n, state, model, vdep, self._tolerance, drifts,
-                    kicks, done, status)
+        halts = None
+        self._contacts = tuple(() for _ in range(self.systems))
+        if self._collisions is not None:
+            halts = self._step_colliding(n, state, model, vdep, family, drifts, kicks, done,
+                                         status)
+        else:
+            advance_all(family, self._t, self._h, n, state, model, vdep, self._tolerance,
+                        drifts, kicks, done, status)
         if family != RK45:
             self._h[:] = h_before
         else:  # as a Simulation does: a failed system keeps the step it had
@@ -532,6 +594,8 @@ class Batch(DeclaresTerms):
         if failed.size:
             m = int(failed[0])
             code = int(status[m])
+            if halts is not None:
+                self._raise_contact(m, code, halts, failed)
             what = {STEP_COLLAPSED: "the rk45 step size collapsed",
                     TIME_OVERFLOW: "the next rk45 step would take the time past the largest float"}
             reason = what.get(code, f"particle {code} got a non-finite position or velocity")
@@ -541,6 +605,28 @@ class Batch(DeclaresTerms):
                 f"state is kept ({failed.size} system(s) failed: {failed[:8].tolist()})",
                 step=int(self._steps[m]), time=float(self._t[m]),
                 particle=code if code >= 0 else None)
+
+    def _raise_contact(self, m, code, halts, failed):
+        """The exception for system m stopped by a contact (``batch_steps`` status codes)."""
+        from .collisions.batch_steps import HALT_STATUS, TOO_MANY_STATUS
+        from .collisions.events import CONTACTS_PER_PARTICLE
+
+        t_m, steps_m = float(self._t[m]), int(self._steps[m])
+        if code == HALT_STATUS:
+            i, j = divmod(int(halts[m, 0]), self.n)
+            raise Collision(
+                f"system {m} of {self.systems}: particles {i} and {j} touched at "
+                f"t={float(halts[m, 1])!r} (normal speed {float(halts[m, 2])!r}) in its step "
+                f"{steps_m} from t={t_m!r}, and collisions say resolve='halt'; that system is "
+                f"left at the start of that step ({failed.size} system(s) stopped: "
+                f"{failed[:8].tolist()})", pair=(i, j), time=float(halts[m, 1]),
+                speed=float(halts[m, 2]), step=steps_m)
+        if code == TOO_MANY_STATUS:
+            raise SimulationError(
+                f"system {m} of {self.systems}: more than {CONTACTS_PER_PARTICLE} contacts per "
+                f"particle in its step {steps_m} from t={t_m!r} (an inelastic collapse); that "
+                "system is left at the start of that step", step=steps_m, time=t_m,
+                particle=None)
 
     def _check_state(self, state):
         """Refuse bad input written into the arrays (ValueError naming the field, system and

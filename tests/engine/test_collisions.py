@@ -342,3 +342,46 @@ def test_contacts_under_forces_converge_at_second_order_with_leapfrog():
     for k in range(2):
         assert scaled[-4:, k].max() < 2.0 * scaled[:4, k].max(), (k, scaled[:, k])
     assert scaled[:, 0].max() < 0.5 and scaled[:, 1].max() < 100.0
+
+
+# -- a batch --------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("resolve", ["bounce", "merge"])
+def test_a_batch_gives_each_system_the_contacts_and_bits_of_a_simulation(resolve):
+    from engine import Batch
+
+    n, systems = 120, 3
+    scenes = [gas(n, 2, seed=20 + m, radius=0.4) for m in range(systems)]
+    batch = Batch(systems=systems, dim=2, integrator="leapfrog", dt=0.05, capacity=n)
+    batch.add_many(mass=np.array([s.mass for s in scenes]), pos=np.array([s.pos for s in scenes]),
+                   vel=np.array([s.vel for s in scenes]),
+                   radius=np.array([s.radius for s in scenes]))
+    walls = box_walls(20.0, dim=2)
+    batch.collisions = Collisions(resolve=resolve, restitution=0.9, walls=walls)
+    batch.step(30)
+    for m, sim in enumerate(scenes):
+        sim.collisions = Collisions(resolve=resolve, restitution=0.9, walls=walls)
+        sim.step(30)
+        assert len(sim.contacts) > 5
+        assert batch.contacts[m] == sim.contacts
+        assert batch.pos[m].tobytes() == sim.pos.tobytes()
+        assert batch.vel[m].tobytes() == sim.vel.tobytes()
+        assert batch.energy_ledger[m] == sim.energy_ledger
+        if resolve == "merge":
+            assert batch.mass[m].tobytes() == sim.mass.tobytes()
+
+
+def test_a_batch_system_that_halts_is_named_and_put_back():
+    from engine import Batch
+
+    batch = Batch(systems=2, dim=2, integrator="leapfrog", dt=1.0, capacity=2)
+    batch.add_many(mass=np.ones((2, 2)),
+                   pos=np.array([[[-3.0, 0.0], [3.0, 0.0]], [[-3.0, 5.0], [3.0, 0.0]]]),
+                   vel=np.array([[[1.0, 0.0], [-1.0, 0.0]], [[1.0, 0.0], [-1.0, 0.0]]]),
+                   radius=np.full((2, 2), 0.5))
+    batch.collisions = Collisions(resolve="halt")
+    with pytest.raises(Collision, match="system 0 of 2") as info:
+        batch.step(4)
+    assert info.value.pair == (0, 1) and info.value.time == pytest.approx(2.5)
+    assert batch.t.tolist() == [2.0, 4.0]  # system 0 stopped before its contact; 1 went on
+    np.testing.assert_array_equal(batch.pos[0, :, 0], [-1.0, 1.0])
