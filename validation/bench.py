@@ -5,7 +5,8 @@ engine and its reference back to back, the ratio of that repetition is kept, and
 of the ratios is reported (with the median times). Sections:
 
 1. direct-sum gravity (leapfrog + NBodyGravity) against REBOUND's leapfrog, N = 256, 1024, 4096,
-   with pair interactions per second and the fraction of a measured machine bound;
+   with pair interactions per second, and the pair kernel alone against the loop that visits
+   each pair from both ends (the engine's former kernel);
 2. the Benchmarks Game n-body workload (Sun and four giant planets, symplectic Euler,
    dt = 0.01) through ``sim.step(n)``, against a plain hand-written numba loop and REBOUND;
 3. scaling of the time per step with N (direct sum) and with N_test (test particles around
@@ -25,7 +26,9 @@ of the ratios is reported (with the median times). Sections:
 11. the tree's gravity, by its fast multipole walk (``NBodyGravity(method="fmm")``) and its
     Barnes-Hut walk (``method="tree"``), on a Plummer sphere against pytreegrav's and
     REBOUND's trees at equal median force error, its scaling with N, its crossover with the
-    direct sum and its memory (``tree_bench``).
+    direct sum and its memory (``tree_bench``);
+12. contact: a hard-sphere gas's collisions found and resolved, against REBOUND's tree
+    collision search on the same scene (``contact_bench``).
 """
 import argparse
 import json
@@ -826,7 +829,7 @@ def machine():
 
 def run(quick=False, sections=None):
     sections = sections or ["direct", "small", "scaling", "terms", "startup", "spacewar", "batch",
-                            "learning", "planets", "cluster", "tree"]
+                            "learning", "planets", "cluster", "tree", "contact"]
     repeats = 3 if quick else 7
     report = {"machine": machine(), "quick": quick}
     if "direct" in sections:
@@ -859,6 +862,12 @@ def run(quick=False, sections=None):
 
         report["tree"] = measure(SIZES["quick" if quick else "full"],
                                  progress=lambda text: print(text, file=sys.stderr))
+    if "contact" in sections:
+        from . import contact_bench
+
+        report["contact"] = contact_bench.measure(
+            contact_bench.SIZES["quick" if quick else "full"], repeats=3,
+            progress=lambda text: print(text, file=sys.stderr))
     return report
 
 
@@ -985,6 +994,10 @@ def targets(r):
         from .tree_bench import targets as tree_targets
 
         rows += tree_targets(r["tree"])
+    if "contact" in r:
+        from .contact_bench import targets as contact_targets
+
+        rows += contact_targets(r)
     return rows
 
 
@@ -1128,6 +1141,10 @@ def format_report(r):
         lines.append("\n11. Tree gravity (FMM and Barnes-Hut) against pytreegrav and REBOUND at "
                      "equal error")
         lines += format_tree(r["tree"])
+    if "contact" in r:
+        from .contact_bench import format_contact
+
+        lines.append(format_contact(r))
     if targets(r):
         lines.append("\ntargets:")
         for name, measured, met in targets(r):
@@ -1301,6 +1318,10 @@ def format_markdown(r, command):
 
         out += ["## 11. Tree gravity (`NBodyGravity(method=\"fmm\")` and `method=\"tree\"`)", ""]
         out += markdown_tree(r["tree"]) + [""]
+    if "contact" in r:
+        from .contact_bench import markdown_contact
+
+        out += markdown_contact(r)
     return "\n".join(out)
 
 
@@ -1312,7 +1333,8 @@ def main(argv=None):
     parser.add_argument("--markdown", metavar="FILE", help="also write the results as Markdown")
     parser.add_argument("--only", metavar="SECTIONS",
                         help="comma-separated sections (default: every one): direct,small,"
-                             "scaling,terms,startup,spacewar,batch,learning,planets,cluster,tree")
+                             "scaling,terms,startup,spacewar,batch,learning,planets,cluster,tree,"
+                             "contact")
     args = parser.parse_args(argv)
     # a bad output path fails now, not after minutes of benchmarks
     try:

@@ -24,7 +24,9 @@ import numpy as np
 
 from ..cache import jit
 from ..space import wrap_scalar
-from .narrow import position
+import heapq
+
+from .narrow import NEVER, pair_time, position
 from .queue import just_met, push_pair
 
 #: from this many active particles on, ``search="auto"`` uses the grid (below it every pair)
@@ -36,8 +38,11 @@ AUTO, DIRECT, GRID = 0, 1, 2
 #: the grid: whether it is used, the cell side, cells a side of a periodic box (0: open
 #: space, hashed), table slots, and each slot's list of bodies (``head[slot]`` the first
 #: entry, ``entries[0, e]`` its body and ``entries[1, e]`` the next entry, -1 ending it;
-#: ``used[0]`` the entries in use)
-Cells = namedtuple("Cells", "use side per_side slots head entries used")
+#: ``used[0]`` the entries in use). For the first search, the bodies sorted by slot:
+#: ``start[slot]`` to ``start[slot + 1]`` index ``ids`` (their numbers) and copies of their
+#: paths and radii, ``Xs``, ``Ds``, ``rs``, so that neighbouring cells' bodies are
+#: neighbours in memory (at 10^5 bodies the search by index order waited on memory)
+Cells = namedtuple("Cells", "use side per_side slots head entries used start ids Xs Ds rs")
 
 #: the hash's primes (Teschner et al. 2003)
 _P1, _P2, _P3 = 73856093, 19349663, 83492791
@@ -97,7 +102,9 @@ def build(X, D, radius, active, n, box, search, live):
     periodic box too small for 3 cells a side."""
     dim = X.shape[0]
     none = Cells(False, 1.0, 0, 1, np.full(1, -1, dtype=np.int64),
-                 np.zeros((2, 1), dtype=np.int64), np.zeros(1, dtype=np.int64))
+                 np.zeros((2, 1), dtype=np.int64), np.zeros(1, dtype=np.int64),
+                 np.zeros(2, dtype=np.int64), np.zeros(1, dtype=np.int64), np.zeros((dim, 1)),
+                 np.zeros((dim, 1)), np.zeros(1))
     if search == DIRECT or (search == AUTO and live < GRID_FROM):
         return none
     side = 0.0
@@ -118,13 +125,36 @@ def build(X, D, radius, active, n, box, search, live):
         slots = 1
         while slots < 2 * live:
             slots *= 2
+    keys = np.empty(n, dtype=np.int64)
+    start = np.zeros(slots + 1, dtype=np.int64)
+    for k in range(n):
+        if active[k]:
+            cx, cy, cz = _corner_cells(X, D, radius, k, side, per_side, box)
+            keys[k] = _slot_of(cx, cy, cz, per_side, slots)
+            start[keys[k] + 1] += 1
+    for c in range(slots):
+        start[c + 1] += start[c]
+    fill = start[:slots].copy()
+    ids = np.empty(live, dtype=np.int64)
+    Xs = np.empty((dim, live))
+    Ds = np.empty((dim, live))
+    rs = np.empty(live)
+    for k in range(n):
+        if active[k]:
+            a = fill[keys[k]]
+            fill[keys[k]] += 1
+            ids[a] = k
+            for axis in range(dim):
+                Xs[axis, a] = X[axis, k]
+                Ds[axis, a] = D[axis, k]
+            rs[a] = radius[k]
     cells = Cells(True, side, per_side, slots, np.full(slots, -1, dtype=np.int64),
-                  np.empty((2, 2 * live + 16), dtype=np.int64), np.zeros(1, dtype=np.int64))
+                  np.empty((2, 2 * live + 16), dtype=np.int64), np.zeros(1, dtype=np.int64),
+                  start, ids, Xs, Ds, rs)
     # listed in descending index order, so that each slot's list runs in ascending order
     for k in range(n - 1, -1, -1):
         if active[k]:
-            cx, cy, cz = _corner_cells(X, D, radius, k, side, per_side, box)
-            cells = _list(cells, _slot_of(cx, cy, cz, per_side, slots), k)
+            cells = _list(cells, keys[k], k)
     return cells
 
 
@@ -139,7 +169,7 @@ def _list(cells, key, k):
         grown[:, :used] = entries
         entries = grown
         cells = Cells(cells.use, cells.side, cells.per_side, cells.slots, cells.head, entries,
-                      cells.used)
+                      cells.used, cells.start, cells.ids, cells.Xs, cells.Ds, cells.rs)
     entries[0, used] = k
     entries[1, used] = cells.head[key]
     cells.head[key] = used
@@ -160,27 +190,49 @@ def _span(lo, hi, side, per_side, box):
     return first, last
 
 
+@jit(error_model="numpy", inline="always")
+def _around(c, per_side):
+    """The cell coordinates c - 1, c, c + 1 along one axis, wrapped in a periodic box without
+    a division (with ``%`` the first search took 85 ms at 10^5 bodies, 69 ms without)."""
+    if per_side == 0:
+        return c - 1, c, c + 1
+    below = c - 1 if c > 0 else per_side - 1
+    above = c + 1 if c < per_side - 1 else 0
+    return below, c, above
+
+
+@jit(error_model="numpy", inline="always")
+def _key(cx, cy, cz, per_side, slots):
+    """The slot of a cell whose coordinates are already in range (periodic), or its hash."""
+    if per_side > 0:
+        return (cz * per_side + cy) * per_side + cx
+    return _slot(cx, cy, cz, slots)
+
+
 @jit(error_model="numpy")
 def all_pairs(cells, X, D, anchor, radius, box, events, version, active):
-    """Queue the first contact of every pair the grid puts near each other (each pair once)."""
+    """Queue the first contact of every pair the grid puts near each other (each pair once),
+    over the bodies sorted by cell (``Cells.Xs``...; every body is at its start, version 0)."""
     dim = X.shape[0]
-    n = X.shape[1]
-    reach_z = 1 if dim == 3 else 0
-    for k in range(n):
-        if not active[k]:
-            continue
-        cx, cy, cz = _corner_cells(X, D, radius, k, cells.side, cells.per_side, box)
-        for oz in range(-reach_z, reach_z + 1):
-            for oy in range(-1, 2):
-                for ox in range(-1, 2):
-                    key = _slot_of(cx + ox, cy + oy, cz + oz, cells.per_side, cells.slots)
-                    e = cells.head[key]
-                    while e >= 0:
-                        other = cells.entries[0, e]
+    per_side, slots = cells.per_side, cells.slots
+    start, ids, Xs, Ds, rs = cells.start, cells.ids, cells.Xs, cells.Ds, cells.rs
+    for a in range(ids.shape[0]):
+        k = ids[a]
+        cx, cy, cz = _corner_cells(Xs, Ds, rs, a, cells.side, per_side, box)
+        xs = _around(cx, per_side)
+        ys = _around(cy, per_side)
+        zs = _around(cz, per_side) if dim == 3 else (cz, cz, cz)
+        for iz in range(3 if dim == 3 else 1):
+            for iy in range(3):
+                for ix in range(3):
+                    key = _key(xs[ix], ys[iy], zs[iz], per_side, slots)
+                    for b in range(start[key], start[key + 1]):
+                        other = ids[b]
                         if other > k:
-                            push_pair(events, X, D, anchor, radius, version, k, other, 0.0,
-                                      box)
-                        e = cells.entries[1, e]
+                            # as every-pair search computes it: the lower index first
+                            s = pair_time(Xs, Ds, anchor, rs, a, b, 0.0, box)
+                            if s != NEVER:
+                                heapq.heappush(events, (s, float(k), float(other), 0.0, 0.0))
 
 
 @jit(error_model="numpy")

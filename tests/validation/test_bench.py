@@ -54,3 +54,17 @@ def test_targets_are_judged_from_the_figures():
     verdicts = [met for _, _, met in bench.targets(report)]
     assert verdicts == [True, True, True, False, False]
     assert "1.61x; the whole step 7.9x REBOUND's (5.0x at 256)" == bench.targets(report)[0][1]
+
+
+def test_the_contact_section_solves_the_same_problem_as_rebound():
+    from validation import contact_bench
+
+    r = contact_bench.measure((600,), repeats=1)
+    (row,) = r["rows"]
+    assert row["engine_contacts_per_step"] > 1
+    # the same gas, seen by two codes: about the same number of contacts a step
+    assert abs(row["engine_contacts_per_step"] / row["rebound_contacts_per_step"] - 1) < 0.35
+    report = {"contact": r}
+    assert contact_bench.targets(report) == []  # below 10^4, one size: no target judged
+    assert "12. Contact" in contact_bench.format_contact(report)
+    assert contact_bench.markdown_contact(report)[0].startswith("## 12. Contact")
