@@ -16,6 +16,13 @@ light, and the GIF is written atomically (``engine.atomic``) to a path checked b
 anything is computed.
 
     python -m engine cloth --out cloth.gif --frames 90
+
+``--tear`` makes the cloth's springs plastic and breakable (``Springs(yield_strain=0.1,
+break_strain=0.3, flow_rate=3)``, ``engine.forces.spring_yield``) and the gale stronger: the
+sail stretches and keeps its dents where the gusts pushed it past yield, and tears where they
+pushed faster than it could flow; a torn triangle is not drawn.
+
+    python -m engine cloth --tear --out sail.gif
 """
 import argparse
 import math
@@ -51,16 +58,24 @@ def require_pillow():
     return Image, ImageDraw
 
 
-def build_scene(grid=16, rope_segments=20, wind=5.0):
+#: the torn sail's springs (``--tear``)
+TEAR = {"yield_strain": 0.05, "break_strain": 0.2, "flow_rate": 3.0}
+
+
+def build_scene(grid=16, rope_segments=20, wind=5.0, tear=False):
     """The simulation (verlet, 3-D, z up) with its cloth and rope; returns
-    ``(sim, cloth_indices, rope_indices, wind_term)``. The step is not set yet."""
+    ``(sim, cloth_indices, rope_indices, wind_term)``. The step is not set yet. ``tear``:
+    the cloth's springs yield and break (``TEAR``)."""
     sim = Simulation(dim=3, integrator="verlet", dt=1e-3)
     # a 1 m x 1 m cloth in the x-z plane, top edge at z = 0, bend springs for some body
     cloth, _ = forces.cloth(sim, corner=(0.0, 0.0, 0.0), edge_u=(1.0, 0.0, 0.0),
                             edge_v=(0.0, 0.0, -1.0), nu=grid, nv=grid, mass=2.5 / grid ** 2,
-                            k=150.0, damping=0.02, bend=True)
+                            k=150.0, damping=0.02, bend=True, **(TEAR if tear else {}))
     sim.pin(int(cloth[0, 0]))
     sim.pin(int(cloth[-1, 0]))
+    if tear:  # a sail laced to its spar along the whole top edge
+        for i in cloth[:, 0]:
+            sim.pin(int(i))
     # a rope beside it, pinned at one end and released horizontally, towards the viewer: it
     # swings down and across, clear of the cloth
     rope, _ = forces.rope(sim, start=(1.6, 0.0, 0.0), end=(2.05, -0.6, 0.0),
@@ -102,6 +117,22 @@ class Camera:
         return x, y, depth
 
 
+def cloth_springs(sim):
+    """The cloth's springs: the scene's first ``Springs`` term (the rope's is the second)."""
+    return next(f for f in sim.forces if isinstance(f, forces.Springs))
+
+
+def _intact(sim, tri):
+    """Which triangles have all three edges' springs whole (a torn one is not drawn)."""
+    springs = cloth_springs(sim)
+    if not springs.broken.any():
+        return np.ones(tri.shape[0], dtype=bool)
+    broken = {(min(a, b), max(a, b)) for a, b in springs.pairs[springs.broken].tolist()}
+    return np.array([not any((min(a, b), max(a, b)) in broken
+                             for a, b in ((t[0], t[1]), (t[1], t[2]), (t[0], t[2])))
+                     for t in tri.tolist()])
+
+
 def draw_frame(sim, cloth, rope, camera, label, Image, ImageDraw):
     """One RGB frame of the scene as it is now."""
     img = Image.new("RGB", (camera.width, camera.height), BACKGROUND)
@@ -122,8 +153,11 @@ def draw_frame(sim, cloth, rope, camera, label, Image, ImageDraw):
     # the rope's segments are painted in the same back-to-front order as the triangles
     segments = np.column_stack((rope[:-1], rope[1:]))
     far = np.concatenate((depth[tri].mean(axis=1), depth[segments].mean(axis=1)))
+    intact = _intact(sim, tri)
     for item in np.argsort(-far, kind="stable"):
         if item < tri.shape[0]:
+            if not intact[item]:
+                continue
             colour = tuple(int(c * shade[item]) for c in CLOTH[stripe[item]])
             corners = [(x[v], y[v]) for v in tri[item]]
             draw.polygon(corners, fill=colour, outline=colour)
@@ -137,14 +171,14 @@ def draw_frame(sim, cloth, rope, camera, label, Image, ImageDraw):
 
 
 def run(out, frames=90, fps=25, width=480, height=360, grid=16, wind=5.0, safety=SAFETY,
-        log=print):
+        log=print, tear=False):
     """Simulate and write the GIF to ``out``; return a summary dict.
 
     The output path is checked before anything else, then Pillow is imported: a bad path or
     a missing Pillow fails before any work."""
     out = check_output_path(out, "gif")
     Image, ImageDraw = require_pillow()
-    sim, cloth, rope, gust = build_scene(grid=grid, wind=wind)
+    sim, cloth, rope, gust = build_scene(grid=grid, wind=wind, tear=tear)
     stable = sim.stable_dt()
     frame_time = 1.0 / fps
     per_frame = max(1, math.ceil(frame_time / (safety * stable)))
@@ -170,10 +204,12 @@ def run(out, frames=90, fps=25, width=480, height=360, grid=16, wind=5.0, safety
 
     atomic_write(out, write, "wb")
     seconds = time.perf_counter() - start
+    broken = int(cloth_springs(sim).broken.sum())
     log(f"wrote {out}: {frames} frames, {sim.t:.2f} s simulated in {sim.steps} steps "
-        f"({seconds:.1f} s)")
+        f"({seconds:.1f} s)" + (f"; {broken} springs broke, {sim.energy_ledger:.3g} J taken by "
+                                "yielding and breaking" if tear else ""))
     return {"out": out, "frames": frames, "steps": sim.steps, "t": sim.t, "dt": sim.dt,
-            "stable_dt": stable}
+            "stable_dt": stable, "broken": broken, "energy_ledger": sim.energy_ledger}
 
 
 def _positive_int(text):
@@ -215,8 +251,10 @@ def add_arguments(parser):
     parser.add_argument("--height", type=_positive_int, default=360)
     parser.add_argument("--grid", type=_positive_int, default=16,
                         help="particles along each side of the cloth (default 16)")
-    parser.add_argument("--wind", type=_nonnegative, default=5.0,
-                        help="mean wind pressure (default 5)")
+    parser.add_argument("--wind", type=_nonnegative, default=None,
+                        help="mean wind pressure (default 5; 46, a gale, with --tear)")
+    parser.add_argument("--tear", action="store_true",
+                        help="springs that yield and break, in a gale: the sail dents and tears")
     parser.add_argument("--safety", type=_fraction, default=SAFETY,
                         help=f"the step as a fraction of sim.stable_dt() (default {SAFETY})")
 
@@ -230,8 +268,10 @@ def main(args, parser):
         parser.error(f"--fps must be at most 50 (GIF frame times are whole hundredths of a "
                      f"second), got {args.fps}")
     try:
+        wind = args.wind if args.wind is not None else (46.0 if args.tear else 5.0)
         return run(args.out, frames=args.frames, fps=args.fps, width=args.width,
-                   height=args.height, grid=args.grid, wind=args.wind, safety=args.safety)
+                   height=args.height, grid=args.grid, wind=wind, safety=args.safety,
+                   tear=args.tear)
     except (OutputPathError, ImportError) as exc:
         parser.error(str(exc))
 

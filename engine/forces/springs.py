@@ -164,11 +164,13 @@ class Springs(Force):
         return f"Springs({len(self)} springs)"
 
 
-def rope(sim, start, end, segments, mass, k, damping=0.0, test=False):
+def rope(sim, start, end, segments, mass, k, damping=0.0, test=False, **plastic):
     """Add a rope of ``segments`` springs from ``start`` to ``end`` at rest.
 
     ``mass`` is the mass of each of the ``segments + 1`` particles. The springs are added to
-    ``sim`` and their rest length is the initial spacing. Returns ``(indices, springs)``.
+    ``sim`` and their rest length is the initial spacing; ``plastic`` (``yield_strain``,
+    ``break_strain``, ``flow_rate``) is passed on to ``Springs``. Returns
+    ``(indices, springs)``.
     """
     segments = int(segments)
     if segments < 1:
@@ -182,17 +184,19 @@ def rope(sim, start, end, segments, mass, k, damping=0.0, test=False):
     idx = sim.add_many(mass=mass, pos=a + frac * (b - a), test=test)
     spacing = float(np.linalg.norm(b - a)) / segments
     springs = Springs(np.column_stack((idx[:-1], idx[1:])), k=k, rest_length=spacing,
-                      damping=damping)
+                      damping=damping, **plastic)
     sim.add_force(springs)
     return idx, springs
 
 
-def cloth(sim, corner, edge_u, edge_v, nu, nv, mass, k, damping=0.0, shear=True, bend=False):
+def cloth(sim, corner, edge_u, edge_v, nu, nv, mass, k, damping=0.0, shear=True, bend=False,
+          **plastic):
     """Add a cloth grid of ``nu x nv`` particles spanning ``corner + [0,1] edge_u + [0,1] edge_v``.
 
     Structural springs join grid neighbours; ``shear`` adds both diagonals of every cell and
-    ``bend`` adds springs skipping one particle. Rest lengths are the initial distances.
-    Returns ``(indices, springs)`` with ``indices`` of shape ``(nu, nv)``.
+    ``bend`` adds springs skipping one particle. Rest lengths are the initial distances;
+    ``plastic`` (``yield_strain``, ``break_strain``, ``flow_rate``) is passed on to
+    ``Springs``. Returns ``(indices, springs)`` with ``indices`` of shape ``(nu, nv)``.
     """
     nu, nv = int(nu), int(nv)
     if nu < 2 or nv < 2:
@@ -223,7 +227,7 @@ def cloth(sim, corner, edge_u, edge_v, nu, nv, mass, k, damping=0.0, shear=True,
     a = flat[[lookup[int(i)] for i in pairs[:, 0]]]
     b = flat[[lookup[int(i)] for i in pairs[:, 1]]]
     rest = np.linalg.norm(b - a, axis=1)
-    springs = Springs(pairs, k=k, rest_length=rest, damping=damping)
+    springs = Springs(pairs, k=k, rest_length=rest, damping=damping, **plastic)
     sim.add_force(springs)
     return idx, springs
 

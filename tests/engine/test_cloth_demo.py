@@ -98,3 +98,17 @@ def test_the_kepler_tour_still_runs_without_a_command():
     helped = subprocess.run([sys.executable, "-m", "engine", "--help"], capture_output=True,
                             text=True, timeout=600)
     assert "cloth" in helped.stdout
+
+
+def test_the_torn_sail_yields_and_tears_and_its_torn_triangles_are_not_drawn(tmp_path, optional):
+    optional("PIL")
+    summary = cloth_demo.run(str(tmp_path / "sail.gif"), frames=40, width=160, height=120,
+                             grid=10, wind=60.0, tear=True, log=lambda text: None)
+    assert summary["energy_ledger"] > 0.0  # yielding and breaking took energy out
+    assert summary["broken"] > 0
+    sim, cloth, _, _ = cloth_demo.build_scene(grid=10, tear=True)
+    springs = cloth_demo.cloth_springs(sim)
+    assert springs.plastic and sim.pinned[cloth[:, 0]].all()  # laced along the spar
+    from engine import forces
+
+    assert cloth_demo._intact(sim, forces.grid_triangles(cloth)).all()  # nothing torn yet
