@@ -11,6 +11,9 @@ rope beside it, drawn to a GIF (``engine.cloth_demo``; needs the ``[viz]`` extra
 galaxies collide under tree gravity and raise tidal tails, drawn to a GIF
 (``engine.galaxies_demo``; needs the ``[viz]`` extra).
 
+``python -m engine asteroids [--out asteroids.gif] [--rocks N] ...``: a belt of asteroids about
+a star that bounce and merge, to a GIF (``engine.asteroids_demo``; needs the ``[viz]`` extra).
+
 ``python -m engine compile [--jobs N] [--list]``: compile the tour's integrators, every force
 kernel and ``Batch``'s executors ahead, one worker process per core (``engine.compile_ahead``).
 The tour itself compiles its integrators so on its first run.
@@ -21,7 +24,8 @@ import time
 
 import numpy as np
 
-from . import INTEGRATORS, Simulation, analytic, cloth_demo, compile_ahead, forces, galaxies_demo
+from . import (INTEGRATORS, Simulation, analytic, asteroids_demo, cloth_demo, compile_ahead,
+               forces, galaxies_demo)
 from .integrators import FORCE_EVALUATIONS, ORDERS
 
 
@@ -60,17 +64,23 @@ def main(argv=None):
     parser.add_argument("--orbits", type=int, default=100)
     parser.add_argument("--evaluations", type=int, default=400,
                         help="force evaluations per orbit for the fixed-step methods")
-    commands = parser.add_subparsers(dest="command", metavar="{cloth,galaxies,compile}",
-                                     help="cloth: the cloth-and-rope GIF demo; galaxies: two "
-                                          "colliding disk galaxies, to a GIF; compile: the "
-                                          "tour's kernels compiled ahead, on every core "
-                                          "(without a command: the Kepler tour)")
+    commands = parser.add_subparsers(dest="command",
+                                     metavar="{cloth,galaxies,asteroids,compile}",
+                                     help="cloth: the cloth-and-rope GIF demo (--tear: a sail "
+                                          "that tears); galaxies: two colliding disk galaxies, "
+                                          "to a GIF; asteroids: rocks that bounce and merge "
+                                          "about a star, to a GIF; compile: the tour's kernels "
+                                          "compiled ahead, on every core (without a command: "
+                                          "the Kepler tour)")
     cloth = commands.add_parser("cloth", help="a pinned cloth in the wind and a rope, to a GIF",
                                 description=cloth_demo.__doc__.split("\n\n")[0])
     cloth_demo.add_arguments(cloth)
     galaxies = commands.add_parser("galaxies", help="two disk galaxies collide, to a GIF",
                                    description=galaxies_demo.__doc__.split("\n\n")[0])
     galaxies_demo.add_arguments(galaxies)
+    asteroids = commands.add_parser("asteroids", help="asteroids bounce and merge, to a GIF",
+                                    description=asteroids_demo.__doc__.split("\n\n")[0])
+    asteroids_demo.add_arguments(asteroids)
     ahead = commands.add_parser("compile", help="compile the engine's kernels ahead, on every core",
                                 description=compile_ahead.__doc__.split("\n\n")[0])
     compile_ahead.add_arguments(ahead)
@@ -80,6 +90,9 @@ def main(argv=None):
         return
     if args.command == "galaxies":
         galaxies_demo.main(args, galaxies)
+        return
+    if args.command == "asteroids":
+        asteroids_demo.main(args, asteroids)
         return
     if args.command == "compile":
         compile_ahead.main(args, compile_ahead.ENGINE)

@@ -547,7 +547,8 @@ class Batch(DeclaresTerms):
         batch_steps.advance_all_colliding(
             family, self._t, self._h, n, state, model, vdep, self._tolerance, drifts, kicks,
             done, status, RESOLVE_CODES[settings.resolve], settings.restitution, points,
-            normals, SEARCH_CODES[settings.search], records, halts)
+            normals, SEARCH_CODES[settings.search], records, halts,
+            -1.0 if settings.merge_below is None else settings.merge_below)
         contacts = []
         for m, record in enumerate(records):
             mine = tuple(Contact(t, int(i), int(j), speed, ACTIONS[int(a)], energy,

@@ -603,7 +603,8 @@ class Simulation(DeclaresTerms):
             v0 = state.vel[:, :n].copy()
             t_before, steps_before = self._t, self.steps
             mark = len(record)
-            merging = settings is not None and settings.resolve == "merge"
+            merging = settings is not None and (settings.resolve == "merge" or
+                                                settings.merge_below is not None)
             if merging:  # a merge changes these: kept to restore a step that fails
                 kept = [getattr(state, f)[:n].copy() for f in ("mass", "charge", "radius",
                                                               "active")]
@@ -617,7 +618,7 @@ class Simulation(DeclaresTerms):
                 status, pair, t_hit, speed = events.collide(
                     t_before, taken, state, model, p0, v0, RESOLVE_CODES[settings.resolve],
                     settings.restitution, points, normals, SEARCH_CODES[settings.search],
-                    record)
+                    record, -1.0 if settings.merge_below is None else settings.merge_below)
             if status == 0:
                 for s, term in plastic:
                     f0, m = int(model.param_offsets[s]), len(term)

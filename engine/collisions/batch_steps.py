@@ -56,7 +56,7 @@ def _restore(s, n, p0, v0, kept, merged):
 @jit(parallel=True, error_model="numpy")
 def advance_all_colliding(family, t, h, steps, state, model, vdep, tol, drifts, kicks, done,
                           status, resolve, restitution, points, normals, search, records,
-                          halts):
+                          halts, merge_below):
     """Every system by ``steps`` steps, each followed by its contacts; ``records[m]`` gets
     system m's contact records, ``halts[m]`` (pair code i * n + j, time, speed) the contact
     that halted it. ``t``, ``h``, ``done`` and ``status`` as ``engine.batch.advance_all``."""
@@ -75,7 +75,7 @@ def advance_all_colliding(family, t, h, steps, state, model, vdep, tol, drifts, 
             record = records[m]
             tm, hm, dm, sm = t[m], h[m], 0, -1
             for _ in range(steps):
-                _keep(s, n, p0, v0, kept, resolve == MERGE)
+                _keep(s, n, p0, v0, kept, resolve == MERGE or merge_below > 0.0)
                 t_before = tm
                 tm, hm, one, sm = step_system(m, family, tm, hm, 1, state, model, work, vdep,
                                               tol, drifts, kicks)
@@ -84,9 +84,9 @@ def advance_all_colliding(family, t, h, steps, state, model, vdep, tol, drifts, 
                 mark = len(record)
                 code, pair, t_hit, speed = collide(t_before, tm - t_before, s, model_m, p0, v0,
                                                    resolve, restitution, points, normals,
-                                                   search, record)
+                                                   search, record, merge_below)
                 if code != DONE:
-                    _restore(s, n, p0, v0, kept, resolve == MERGE)
+                    _restore(s, n, p0, v0, kept, resolve == MERGE or merge_below > 0.0)
                     while len(record) > mark:
                         record.pop()
                     tm = t_before

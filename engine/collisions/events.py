@@ -80,11 +80,23 @@ def _search_again(events, X, D, anchor, radius, version, active, k, s0, box, poi
     return cells
 
 
+@jit(error_model="numpy", inline="always")
+def _normal_speed_at(X, D, anchor, v0, v1, i, j, s, box):
+    """-u_n: how fast i and j close along their line of centres at fraction s (0 when their
+    centres coincide)."""
+    dx, dy, dz = separation(X, D, anchor, i, j, s, box)
+    dist = math.sqrt(dx * dx + dy * dy + dz * dz)
+    if dist == 0.0:
+        return 0.0
+    return -normal_speed(v0, v1, i, j, s, dx / dist, dy / dist, dz / dist)
+
+
 @jit(error_model="numpy")
 def collide(t0, h, state, model, p0, v0, resolve, restitution, points, normals, search,
-            contacts):
+            contacts, merge_below=-1.0):
     """Find and resolve the contacts of the step just taken from (p0, v0) to the state's
-    positions and velocities (which it changes), from time t0 over h. Appends to ``contacts``
+    positions and velocities (which it changes), from time t0 over h; with ``resolve`` BOUNCE,
+    a pair meeting at a normal speed below ``merge_below`` merges. Appends to ``contacts``
     one (time, i, j, speed, action, energy, survivor) tuple per contact, in order. Returns (status,
     index of the halting contact's pair as i * n + j, its time, its speed)."""
     n = state.n
@@ -142,13 +154,11 @@ def collide(t0, h, state, model, p0, v0, resolve, restitution, points, normals, 
             action = WALL
             j_record = j - n
         elif resolve == HALT:
-            dx, dy, dz = separation(X, D, anchor, i, j, s, box)
-            dist = math.sqrt(dx * dx + dy * dy + dz * dz)
-            un = 0.0
-            if dist > 0.0:
-                un = normal_speed(v0, v1, i, j, s, dx / dist, dy / dist, dz / dist)
-            return HALTED, i * n + j, t0 + s * h, -un
-        elif resolve == MERGE:
+            return HALTED, i * n + j, t0 + s * h, _normal_speed_at(X, D, anchor, v0, v1, i, j,
+                                                                   s, box)
+        elif resolve == MERGE or (merge_below > 0.0 and
+                                  _normal_speed_at(X, D, anchor, v0, v1, i, j, s, box) <
+                                  merge_below):
             speed = relative_speed(v0, v1, i, j, s)
             keep, gone = survivor_of(pinned, i, j)
             before = _energy(t0 + h, state, model, energies)

@@ -106,14 +106,26 @@ class Collisions:
       ``engine.Collision`` and the state is left at the start of that step);
     - ``restitution``: e in [0, 1], the ratio of the normal relative speeds after and before
       a bounce (walls use it too);
+    - ``merge_below``: with ``resolve="bounce"``, a speed: a pair that meets slower than it
+      (the normal component of the relative velocity) merges instead of bouncing (the
+      accretion of rubble piles: bodies that meet slower than their escape speed stick);
+      None (the default): every contact bounces;
     - ``walls``: static planes (``Wall``, ``box_walls``) every particle bounces off;
     - ``search``: how candidate pairs are found: ``"direct"`` (every pair), ``"grid"`` (a
       uniform grid of cells as large as the largest distance a sphere sweeps in a step), or
       ``"auto"`` (the grid from ``GRID_FROM`` active particles on).
     """
 
-    def __init__(self, resolve="bounce", restitution=1.0, walls=(), search="auto"):
+    def __init__(self, resolve="bounce", restitution=1.0, walls=(), search="auto",
+                 merge_below=None):
         resolve = one_of(*RESOLVE)("resolve", resolve)
+        if merge_below is not None:
+            merge_below = finite_float("merge_below", merge_below)
+            if merge_below < 0.0:
+                raise ValueError(f"merge_below must be >= 0 (a speed), got {merge_below!r}")
+            if resolve != "bounce":
+                raise ValueError(f"merge_below={merge_below!r} chooses between a bounce and a "
+                                 f"merge; it needs resolve='bounce', got resolve={resolve!r}")
         restitution = finite_float("restitution", restitution)
         if not 0.0 <= restitution <= 1.0:
             raise ValueError(f"restitution must be in [0, 1], got {restitution!r} (0: the pair "
@@ -130,6 +142,7 @@ class Collisions:
         self.restitution = restitution
         self.walls = walls
         self.search = search
+        self.merge_below = merge_below
 
     def wall_arrays(self, dim):
         """The walls' points and unit normals as two (3, W) arrays (z = 0 in 2-D)."""
@@ -144,4 +157,5 @@ class Collisions:
 
     def __repr__(self):
         return (f"Collisions(resolve={self.resolve!r}, restitution={self.restitution!r}, "
-                f"walls={len(self.walls)} walls, search={self.search!r})")
+                f"walls={len(self.walls)} walls, search={self.search!r}, "
+                f"merge_below={self.merge_below!r})")

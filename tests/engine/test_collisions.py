@@ -385,3 +385,20 @@ def test_a_batch_system_that_halts_is_named_and_put_back():
     assert info.value.pair == (0, 1) and info.value.time == pytest.approx(2.5)
     assert batch.t.tolist() == [2.0, 4.0]  # system 0 stopped before its contact; 1 went on
     np.testing.assert_array_equal(batch.pos[0, :, 0], [-1.0, 1.0])
+
+
+def test_merge_below_merges_the_slow_contacts_and_bounces_the_fast():
+    sim = Simulation(dim=2, integrator="leapfrog", dt=1.0)
+    sim.add(mass=1.0, pos=(-2.0, 0.0), vel=(0.5, 0.0), radius=0.5)   # meet at 1.0: slow
+    sim.add(mass=1.0, pos=(2.0, 0.0), vel=(-0.5, 0.0), radius=0.5)
+    sim.add(mass=1.0, pos=(-2.0, 10.0), vel=(3.0, 0.0), radius=0.5)  # meet at 6.0: fast
+    sim.add(mass=1.0, pos=(2.0, 10.0), vel=(-3.0, 0.0), radius=0.5)
+    sim.collisions = Collisions(restitution=1.0, merge_below=2.0)
+    sim.step(4)
+    actions = sorted((c.i, c.j, c.action) for c in sim.contacts)
+    assert actions == [(0, 1, "merge"), (2, 3, "bounce")]
+    assert sim.active.tolist() == [True, False, True, True]
+    with pytest.raises(ValueError, match="merge_below.*resolve='bounce'"):
+        Collisions(resolve="merge", merge_below=1.0)
+    with pytest.raises(ValueError, match="merge_below must be >= 0"):
+        Collisions(merge_below=-1.0)
