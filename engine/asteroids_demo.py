@@ -13,7 +13,6 @@ atomically to a path checked before anything is computed.
 
     python -m engine asteroids --out asteroids.gif --rocks 300 --frames 150
 """
-import argparse
 import math
 import time
 
