@@ -108,6 +108,7 @@ class Simulation(DeclaresTerms):
         # key of the terms' id() would match a removed term's reused address)
         self._revision = 0
         self._collisions = None  # engine.Collisions, or None: nothing touches
+        self._plastic, self._plastic_key = [], None
         self._contacts = ()
         #: the energy contacts took out (inelastic bounces, merges) since the simulation began:
         #: ``sim.energy() + sim.energy_ledger`` is what contacts leave unchanged
@@ -555,9 +556,17 @@ class Simulation(DeclaresTerms):
             self._run(last, 1, math.nan, keep_dt=True)
         self._t = t_end
 
+    def _plastic_terms(self):
+        """The declared springs that yield or break, with their positions among the terms
+        (found again only when the terms change: ``step`` is called once a frame by games)."""
+        if self._plastic_key != self._revision:
+            self._plastic = [(s, f) for s, f in enumerate(self._forces)
+                             if isinstance(f, Springs) and f.plastic]
+            self._plastic_key = self._revision
+        return self._plastic
+
     def _run(self, h, steps, t_end, keep_dt=False):
-        plastic = [(s, f) for s, f in enumerate(self._forces)
-                   if isinstance(f, Springs) and f.plastic]
+        plastic = self._plastic_terms()
         if self._collisions is not None or plastic:
             self._run_with_contact(h, steps, t_end, keep_dt, plastic)
         else:

@@ -277,7 +277,7 @@ def test_contacts_are_in_time_order_and_deterministic():
 # -- integrators through a merge --------------------------------------------------------------
 
 @pytest.mark.parametrize("integrator", ["symplectic_euler", "leapfrog", "verlet", "yoshida4",
-                                        "rk4", "rk45", "ias15", "whfast"])
+                                        "pefrl", "rk4", "rk45", "ias15", "whfast", "saba"])
 def test_every_integrator_family_goes_on_through_a_merge(integrator):
     sim = Simulation(dim=3, integrator=integrator, dt=1e-3)
     sim.add(mass=1.0, pos=(0.0, 0.0, 0.0), radius=0.05)
@@ -402,3 +402,39 @@ def test_merge_below_merges_the_slow_contacts_and_bounces_the_fast():
         Collisions(resolve="merge", merge_below=1.0)
     with pytest.raises(ValueError, match="merge_below must be >= 0"):
         Collisions(merge_below=-1.0)
+
+
+def test_a_test_particle_bounces_off_a_massive_body_with_its_own_mass():
+    """A test particle feels no gravity of other test particles and is no source, but it has
+    a mass and collides like any body: a light one off a heavy one, head on, e = 1."""
+    sim = Simulation(dim=2, integrator="leapfrog", dt=1.0)
+    sim.add(mass=1e-3, pos=(-2.0, 0.0), vel=(1.0, 0.0), radius=0.5, test=True)
+    sim.add(mass=1.0, pos=(0.0, 0.0), radius=0.5)
+    sim.collisions = Collisions()
+    sim.step(2)
+    w1, w2 = head_on(1e-3, 1.0, 1.0, 0.0, 1.0)
+    np.testing.assert_allclose(sim.vel[:, 0], [w1, w2], rtol=1e-14)
+    massless = Simulation(dim=2, integrator="leapfrog", dt=1.0)
+    massless.add(mass=0.0, pos=(-2.0, 0.0), vel=(1.0, 0.0), radius=0.5, test=True)
+    massless.add(mass=1.0, pos=(0.0, 0.0), radius=0.5)
+    massless.collisions = Collisions(restitution=0.5)
+    massless.step(2)
+    # the massless particle takes the whole change, the body none (the limit m -> 0)
+    np.testing.assert_allclose(massless.vel[:, 0], [-0.5, 0.0], atol=1e-15)
+
+
+def test_a_scene_without_collisions_imports_none_of_their_kernels():
+    import subprocess
+    import sys
+
+    code = ("import sys, numpy as np\n"
+            "from engine import Simulation, forces\n"
+            "sim = Simulation(dim=2, integrator='leapfrog', dt=0.01)\n"
+            "sim.add_many(mass=1.0, pos=np.random.default_rng(1).normal(size=(20, 2)), radius=0.1)\n"
+            "sim.add_force(forces.NBodyGravity(softening=0.1))\n"
+            "sim.step(10)\n"
+            "print(sorted(m for m in sys.modules if m.startswith('engine.collisions.') or\n"
+            "             m == 'engine.forces.spring_yield'))\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True).stdout.strip()
+    assert out == "['engine.collisions.settings']"
