@@ -39,6 +39,7 @@ from . import diagnostics
 from . import integrators as _integrators
 from ._validate import (finite_float, int_in_range, nonnegative_float, positive_float, real_array,
                         step_count)
+from .collisions.settings import DeclaresCollisions
 from .errors import Collision, SimulationError
 from .forces.base import DeclaresTerms
 from .forces.dispatch import pack, potential_terms
@@ -154,7 +155,7 @@ def momenta(state, moving, out):
         out[m] = diagnostics.momentum(state.vel[m], state.mass[m], moving[m], state.n)
 
 
-class Batch(DeclaresTerms):
+class Batch(DeclaresTerms, DeclaresCollisions):
     """M independent systems with the same force terms and particle slots (see the module).
 
     Parameters mirror ``Simulation``'s: ``systems`` (M >= 1), ``dim``, ``integrator``, ``dt``,
@@ -507,22 +508,6 @@ class Batch(DeclaresTerms):
         return state, self._current_model()
 
     # -- contact -----------------------------------------------------------------------
-    @property
-    def collisions(self):
-        """Every system's contacts (``engine.Collisions``, as ``Simulation.collisions``), or
-        None."""
-        return self._collisions
-
-    @collisions.setter
-    def collisions(self, value):
-        from .collisions import Collisions
-
-        if value is not None and not isinstance(value, Collisions):
-            raise TypeError(f"collisions must be an engine.Collisions or None, got {value!r}")
-        if value is not None:
-            value.wall_arrays(self.dim)
-        self._collisions = value
-
     @property
     def contacts(self):
         """The last ``step`` call's contacts: one tuple of ``engine.Contact`` per system."""

@@ -11,6 +11,7 @@ import numpy as np
 from . import diagnostics
 from . import integrators as _integrators
 from ._validate import MAX_STEPS, finite_float, nonnegative_float, positive_float, real_array, step_count
+from .collisions.settings import DeclaresCollisions
 from .errors import Collision, SimulationError
 from .forces.base import DeclaresTerms
 from .forces import tree_terms
@@ -32,7 +33,7 @@ _MAX_STEPS = MAX_STEPS
 MAX_CAPACITY = 2 ** 31  # initial room beyond this is a mistake, not a plan (16 GiB of positions)
 
 
-class Simulation(DeclaresTerms):
+class Simulation(DeclaresTerms, DeclaresCollisions):
     """A set of particles moved by declared force terms with a chosen integrator.
 
     Parameters
@@ -128,22 +129,6 @@ class Simulation(DeclaresTerms):
     @integrator.setter
     def integrator(self, name):
         self._integrator = _integrators.check_name(name)
-
-    @property
-    def collisions(self):
-        """How particles' spheres meet: an ``engine.Collisions``, or None (the default:
-        particles pass through each other, and no contact code is compiled or run)."""
-        return self._collisions
-
-    @collisions.setter
-    def collisions(self, value):
-        from .collisions import Collisions
-
-        if value is not None and not isinstance(value, Collisions):
-            raise TypeError(f"collisions must be an engine.Collisions or None, got {value!r}")
-        if value is not None:
-            value.wall_arrays(self.dim)  # walls of another dimension: refused now
-        self._collisions = value
 
     @property
     def contacts(self):

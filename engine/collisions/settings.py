@@ -159,3 +159,29 @@ class Collisions:
         return (f"Collisions(resolve={self.resolve!r}, restitution={self.restitution!r}, "
                 f"walls={len(self.walls)} walls, search={self.search!r}, "
                 f"merge_below={self.merge_below!r})")
+
+
+def checked(value, dim):
+    """``value`` if it can be a ``dim``-D scene's collisions (an ``engine.Collisions`` whose
+    walls are ``dim``-D, or None), else the error naming it: what ``sim.collisions = ...`` and
+    ``batch.collisions = ...`` check before anything changes."""
+    if value is not None and not isinstance(value, Collisions):
+        raise TypeError(f"collisions must be an engine.Collisions or None, got {value!r}")
+    if value is not None:
+        value.wall_arrays(dim)  # walls of another dimension: refused now
+    return value
+
+
+class DeclaresCollisions:
+    """The ``collisions`` property a ``Simulation`` and a ``Batch`` share (their ``dim`` names
+    the walls' dimension)."""
+
+    @property
+    def collisions(self):
+        """How particles' spheres meet: an ``engine.Collisions``, or None (the default:
+        particles pass through each other, and no contact code is compiled or run)."""
+        return self._collisions
+
+    @collisions.setter
+    def collisions(self, value):
+        self._collisions = checked(value, self.dim)
