@@ -122,7 +122,7 @@ def cloth_springs(sim):
     return next(f for f in sim.forces if isinstance(f, forces.Springs))
 
 
-def _intact(sim, tri):
+def intact(sim, tri):
     """Which triangles have all three edges' springs whole (a torn one is not drawn)."""
     springs = cloth_springs(sim)
     if not springs.broken.any():
@@ -153,10 +153,10 @@ def draw_frame(sim, cloth, rope, camera, label, Image, ImageDraw):
     # the rope's segments are painted in the same back-to-front order as the triangles
     segments = np.column_stack((rope[:-1], rope[1:]))
     far = np.concatenate((depth[tri].mean(axis=1), depth[segments].mean(axis=1)))
-    intact = _intact(sim, tri)
+    whole = intact(sim, tri)
     for item in np.argsort(-far, kind="stable"):
         if item < tri.shape[0]:
-            if not intact[item]:
+            if not whole[item]:
                 continue
             colour = tuple(int(c * shade[item]) for c in CLOTH[stripe[item]])
             corners = [(x[v], y[v]) for v in tri[item]]
@@ -276,4 +276,5 @@ def main(args, parser):
         parser.error(str(exc))
 
 
-__all__ = ["run", "build_scene", "draw_frame", "Camera", "add_arguments", "main"]
+__all__ = ["run", "build_scene", "draw_frame", "Camera", "add_arguments", "main", "intact",
+           "cloth_springs", "TEAR"]

@@ -111,4 +111,4 @@ def test_the_torn_sail_yields_and_tears_and_its_torn_triangles_are_not_drawn(tmp
     assert springs.plastic and sim.pinned[cloth[:, 0]].all()  # laced along the spar
     from engine import forces
 
-    assert cloth_demo._intact(sim, forces.grid_triangles(cloth)).all()  # nothing torn yet
+    assert cloth_demo.intact(sim, forces.grid_triangles(cloth)).all()  # nothing torn yet
