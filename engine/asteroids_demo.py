@@ -20,7 +20,7 @@ import numpy as np
 
 from . import forces
 from .atomic import OutputPathError, atomic_write, check_output_path
-from .cloth_demo import _positive_int, require_pillow
+from .cloth_demo import positive_int, require_pillow
 from .collisions import Collisions
 from .simulation import Simulation
 
@@ -122,12 +122,12 @@ def run(out, rocks=300, frames=150, steps_per_frame=25, size=480, seed=1, log=pr
 def add_arguments(parser):
     parser.add_argument("--out", default="asteroids.gif",
                         help="the GIF to write (default asteroids.gif)")
-    parser.add_argument("--rocks", type=_positive_int, default=300, help="rocks (default 300)")
-    parser.add_argument("--frames", type=_positive_int, default=150,
+    parser.add_argument("--rocks", type=positive_int, default=300, help="rocks (default 300)")
+    parser.add_argument("--frames", type=positive_int, default=150,
                         help="frames (default 150)")
-    parser.add_argument("--steps", type=_positive_int, default=25,
+    parser.add_argument("--steps", type=positive_int, default=25,
                         help="leapfrog steps a frame (default 25)")
-    parser.add_argument("--size", type=_positive_int, default=480,
+    parser.add_argument("--size", type=positive_int, default=480,
                         help="the square frame's side in pixels (default 480)")
     parser.add_argument("--seed", type=int, default=1)
 

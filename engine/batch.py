@@ -95,7 +95,7 @@ def step_system(m, family, t, h, steps, state, model, work, vdep, tol, drifts, k
 
 
 @jit(error_model="numpy", inline="always")
-def _workspace(n):
+def system_workspace(n):
     """The scratch a ``Simulation`` of n slots would get, kept on this thread."""
     if n >= PARALLEL_MIN:
         return Workspace(np.empty(float_count(n)), np.empty(n, dtype=np.int64), False)
@@ -116,7 +116,7 @@ def advance_all(family, t, h, steps, state, model, vdep, tol, drifts, kicks, don
     systems = state.pos.shape[0]
     chunks = min(systems, CHUNKS)
     for c in prange(chunks):
-        work = _workspace(state.n)
+        work = system_workspace(state.n)
         for m in range(c * systems // chunks, (c + 1) * systems // chunks):
             tm, hm, dm, sm = step_system(m, family, t[m], h[m], steps, state, model, work, vdep,
                                          tol, drifts, kicks)

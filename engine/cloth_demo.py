@@ -212,7 +212,7 @@ def run(out, frames=90, fps=25, width=480, height=360, grid=16, wind=5.0, safety
             "stable_dt": stable, "broken": broken, "energy_ledger": sim.energy_ledger}
 
 
-def _positive_int(text):
+def positive_int(text):
     try:
         value = int(text)
     except ValueError:
@@ -244,12 +244,12 @@ def _nonnegative(text):
 
 def add_arguments(parser):
     parser.add_argument("--out", default="cloth.gif", help="the GIF to write (default cloth.gif)")
-    parser.add_argument("--frames", type=_positive_int, default=90, help="frames (default 90)")
-    parser.add_argument("--fps", type=_positive_int, default=25,
+    parser.add_argument("--frames", type=positive_int, default=90, help="frames (default 90)")
+    parser.add_argument("--fps", type=positive_int, default=25,
                         help="frames per simulated second, and the GIF's speed (default 25)")
-    parser.add_argument("--width", type=_positive_int, default=480)
-    parser.add_argument("--height", type=_positive_int, default=360)
-    parser.add_argument("--grid", type=_positive_int, default=16,
+    parser.add_argument("--width", type=positive_int, default=480)
+    parser.add_argument("--height", type=positive_int, default=360)
+    parser.add_argument("--grid", type=positive_int, default=16,
                         help="particles along each side of the cloth (default 16)")
     parser.add_argument("--wind", type=_nonnegative, default=None,
                         help="mean wind pressure (default 5; 46, a gale, with --tear)")

@@ -65,7 +65,7 @@ def test_the_check_finds_a_private_use():
     import tempfile
     with tempfile.NamedTemporaryFile("w", suffix=".py", delete=False) as f:
         f.write("from engine._validate import finite_float\nimport engine._cache\n"
-                "from engine.forces.base import _read_only\nsim._current_model()\n")
+                "from engine.forces.base import _sealing\nsim._current_model()\n")
     found = _offences(Path(f.name), _engine_private_attributes())
     Path(f.name).unlink()
     assert len(found) == 4, found

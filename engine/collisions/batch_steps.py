@@ -10,7 +10,7 @@ step and stops; the others go on.
 import numpy as np
 from numba import prange
 
-from ..batch import CHUNKS, _workspace, step_system, system_model, system_state
+from ..batch import CHUNKS, step_system, system_model, system_state, system_workspace
 from ..cache import jit
 from .events import DONE, HALTED, MERGE, collide
 
@@ -65,7 +65,7 @@ def advance_all_colliding(family, t, h, steps, state, model, vdep, tol, drifts, 
     n = state.n
     dim = state.pos.shape[1]
     for c in prange(chunks):
-        work = _workspace(n)
+        work = system_workspace(n)
         p0 = np.empty((dim, n))
         v0 = np.empty((dim, n))
         kept = np.empty((4, n))

@@ -125,7 +125,7 @@ class Force:
         if name.startswith("_") or isinstance(getattr(type(self), name, None), property):
             object.__setattr__(self, name, value)
             return
-        value = _read_only(value)
+        value = read_only(value)
         check = self._settable.get(name)
         if check is None:
             if self.__dict__.get("_sealed", False):
@@ -228,7 +228,7 @@ def check_particles(name, indices, sim):
                          f"(the simulation has {sim.n} particles)")
 
 
-def _read_only(value):
+def read_only(value):
     """A read-only view of an array (the caller's own array keeps its flags)."""
     if isinstance(value, np.ndarray):
         value = value.view()

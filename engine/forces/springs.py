@@ -22,7 +22,7 @@ import numpy as np
 from ..cache import jit
 
 from ._kernels import add_force, delta, delta_periodic
-from .base import Force, _read_only
+from .base import Force, read_only
 from .._validate import index_array, per_item, vector, positive_float, nonnegative_float
 
 KIND = 4
@@ -140,7 +140,7 @@ class Springs(Force):
         packed model holds them already: no re-pack)."""
         object.__setattr__(self, "_broken", self.broken | ((k == 0.0) & (self.k > 0.0)))
         for name, value in (("rest_length", rest_length), ("k", k), ("damping", damping)):
-            object.__setattr__(self, name, _read_only(value.copy()))
+            object.__setattr__(self, name, read_only(value.copy()))
 
     def __len__(self):
         return self.pairs.shape[0]
