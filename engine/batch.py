@@ -533,7 +533,8 @@ class Batch(DeclaresTerms, DeclaresCollisions):
             family, self._t, self._h, n, state, model, vdep, self._tolerance, drifts, kicks,
             done, status, RESOLVE_CODES[settings.resolve], settings.restitution, points,
             normals, SEARCH_CODES[settings.search], records, halts,
-            -1.0 if settings.merge_below is None else settings.merge_below)
+            -1.0 if settings.merge_below is None else settings.merge_below,
+            settings.resolve_at == "end")
         contacts = []
         for m, record in enumerate(records):
             mine = tuple(Contact(t, int(i), int(j), speed, ACTIONS[int(a)], energy,

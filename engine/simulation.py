@@ -575,6 +575,10 @@ class Simulation(DeclaresTerms, DeclaresCollisions):
                              "nothing was changed")
         if settings is not None:
             from .collisions import events
+            if settings.resolve_at == "end":
+                from .collisions.end_of_step import collide_at_end as collide
+            else:
+                collide = events.collide
             points, normals = settings.wall_arrays(self.dim)
         if plastic:
             from .forces import spring_yield
@@ -609,7 +613,7 @@ class Simulation(DeclaresTerms, DeclaresCollisions):
             taken = self._t - t_before
             status = 0
             if settings is not None:
-                status, pair, t_hit, speed = events.collide(
+                status, pair, t_hit, speed = collide(
                     t_before, taken, state, model, p0, v0, RESOLVE_CODES[settings.resolve],
                     settings.restitution, points, normals, SEARCH_CODES[settings.search],
                     record, -1.0 if settings.merge_below is None else settings.merge_below)

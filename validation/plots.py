@@ -312,3 +312,44 @@ def tree_time(section, path):
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     _save(fig, path)
+
+
+#: the accretion runs' styles: (label, colour, line style)
+ACCRETION_STYLE = {
+    "rebound": ("REBOUND, line search + merge", "black", "-"),
+    "end": ("engine, resolve_at='end'", "tab:orange", "--"),
+    "contact": ("engine, at the moment of contact", "tab:blue", ":"),
+}
+
+
+def contact(section, path):
+    """Left: the gas's speeds (histogram, in units of sqrt(kT)) against the Maxwell-Boltzmann
+    law of each dimension. Right: merges done by each step in the three accretion runs."""
+    from .contact import speed_cdf
+
+    fig, (left, right) = plt.subplots(1, 2, figsize=(11.0, 4.0), layout="constrained")
+    for (name, g), colour in zip(section["gas"].items(), ("tab:blue", "tab:red")):
+        bins = np.array(g["speed_bins"])
+        counts = np.array(g["speed_counts"])
+        density = counts / (counts.sum() * np.diff(bins))
+        left.stairs(density, bins, color=colour, label=f"{name}, {g['n']} spheres")
+        x = np.linspace(bins[0], bins[-1], 200)
+        pdf = np.gradient(speed_cdf(x, g["dim"], 1.0), x)
+        left.plot(x, pdf, color=colour, ls="--", lw=1,
+                  label="Rayleigh" if g["dim"] == 2 else "Maxwell")
+    left.set_xlabel("speed / sqrt(kT/m)")
+    left.set_ylabel("probability density")
+    left.set_title("hard-sphere gas after relaxing (started at one speed)")
+    left.legend(fontsize=8)
+    a = section["accretion"]
+    for name, run in a["runs"].items():
+        label, colour, ls = ACCRETION_STYLE[name]
+        right.step([0] + a["marks"], [0] + run["merges_by_step"], where="post", color=colour,
+                   ls=ls, label=label)
+    right.set_xlabel("step")
+    right.set_ylabel("merges done")
+    right.set_title(f"accretion: {a['n']} planetesimals, leapfrog, dt = {a['dt']:g}")
+    right.legend(fontsize=8)
+    for ax in (left, right):
+        ax.grid(True, alpha=0.3)
+    _save(fig, path)

@@ -22,13 +22,14 @@ import numpy as np
 import engine
 from engine.atomic import OutputPathError, atomic_write, check_output_dir, check_output_path
 
-from . import drift, hardcases, plots, sweeps, tree_bench, twobody
+from . import contact, drift, hardcases, plots, sweeps, tree_bench, twobody
 from .jobs import Job, run_jobs
 from .problems import kepler, make_sim
 from .reference import rebound_version
 from .settings import LEVELS
 
-SECTIONS = ("crosscheck", "two_body", "energy_drift", "work_precision", "hard_cases", "tree")
+SECTIONS = ("crosscheck", "two_body", "energy_drift", "work_precision", "hard_cases", "tree",
+            "contact")
 
 
 # -- running ---------------------------------------------------------------------------------------
@@ -72,6 +73,8 @@ def collect(level, workers=2, progress=True, sections=SECTIONS, scheduler=None):
         jobs += hardcases.jobs(level)
     if "work_precision" in sections:
         jobs += sweeps.reference_jobs(level)
+    if "contact" in sections:
+        jobs += contact_jobs(level)
     t_a = time.perf_counter()
     results, _ = run_jobs(jobs, workers=workers, desc="untimed runs", disable=not progress,
                           scheduler=scheduler)
@@ -96,6 +99,10 @@ def collect(level, workers=2, progress=True, sections=SECTIONS, scheduler=None):
         phase_b = time.perf_counter() - t_b
     if "hard_cases" in sections:
         out["hard_cases"] = hardcases.assemble(level, results)
+    if "contact" in sections:
+        out["contact"] = {"gas": {f"{dim}-D": results[("contact", "gas", dim)]
+                                  for dim in contact.GAS},
+                          "accretion": results[("contact", "accretion")]}
     phase_c = 0.0
     if "tree" in sections:  # timed: alone in this process, after everything else
         t_c = time.perf_counter()
@@ -106,6 +113,19 @@ def collect(level, workers=2, progress=True, sections=SECTIONS, scheduler=None):
     out["timings"] = {"wall_s": time.perf_counter() - t_start, "untimed_phase_wall_s": phase_a,
                       "timed_phase_wall_s": phase_b, "tree_phase_wall_s": phase_c}
     return out
+
+
+def contact_jobs(level):
+    """The contact section's runs: the two gases and the accretion disk (untimed)."""
+    relax, span = contact.GAS_TIMES[level.name]
+    n, steps, dt, radius = contact.ACCRETION[level.name]
+    jobs = [Job(("contact", "gas", dim), "contact:gas_run",
+                dict(dim=dim, n=n_gas, packing=packing, relax=relax, span=span),
+                cost=n_gas * (relax + span) * 4000)
+            for dim, (n_gas, packing) in contact.GAS.items()]
+    jobs.append(Job(("contact", "accretion"), "contact:accretion_run",
+                    dict(n=n, steps=steps, dt=dt, radius=radius), cost=n * steps * 3))
+    return jobs
 
 
 def meta(level, workers, scheduler=None):
@@ -1019,6 +1039,103 @@ def tree_findings(sec):
     return "**Findings.** " + " ".join(parts)
 
 
+def section_contact(sec, fig):
+    """Section 7: contact against statistical mechanics and against REBOUND."""
+    lines = ["## 7. Contact: a hard-sphere gas and an accreting disk", ""]
+    lines.append(
+        "`sim.collisions = engine.Collisions(...)` finds every pair whose spheres touch during "
+        "a step along the bodies' paths and resolves each at the moment of contact "
+        "(`docs/engine.md`, \"Contact\"). **The gas**: equal hard disks (2-D) and hard spheres "
+        "(3-D) in a periodic box, started at one speed in random directions, elastic. Their "
+        "speeds should relax to the Maxwell-Boltzmann law of the dimension (Rayleigh in 2-D, "
+        "Maxwell in 3-D: a Kolmogorov-Smirnov test, whose p-value at the start is the "
+        "control), and the compressibility Z = PV/NkT from the collisional virial "
+        "(Allen & Tildesley, *Computer Simulation of Liquids*, section 2.4) should match "
+        "Henderson's hard-disk equation of state (1975) and Carnahan & Starling's "
+        "hard-sphere one (1969).")
+    lines.append("")
+    lines.append(f"![speeds of the gas, and merges in the disk]({fig})")
+    lines.append("")
+    rows = []
+    for name, g in sec["gas"].items():
+        rows.append([name, g["n"], g["packing"], f"{g['contacts_per_sphere']:.0f}",
+                     f(g["start_p"]), ", ".join(f(p) for p in g["p_values"]),
+                     f"{g['z']:.4f}", f"{g['z_expected']:.4f} ({g['z_law']})",
+                     f"{100 * (g['z'] / g['z_expected'] - 1):+.2f}%", f(g["energy_error"])])
+    lines.append(table(["gas", "spheres", "packing", "contacts a sphere", "KS p at start",
+                        "KS p after relaxing", "Z measured", "Z expected", "difference",
+                        "energy error"], rows))
+    lines.append("")
+    a = sec["accretion"]
+    lines.append(
+        f"**The accretion disk**: a star and {a['n']} planetesimals (mass 1e-6, radius "
+        f"{a['radius']:g}, a in [0.8, 1.2], e < 0.05, inclination < 0.01, none touching at "
+        f"the start, G = 1), {a['steps']} leapfrog steps of {a['dt']:g} "
+        f"({a['steps'] * a['dt'] / (2 * math.pi):.1f} orbits at a = 1), merging on contact, "
+        "three ways: REBOUND's `collision = \"line\"` with its merge (a Python "
+        "`collision_resolve` that does what `reb_collision_resolve_merge` does and logs the "
+        "pair); the engine with `resolve_at=\"end\"` (REBOUND's way: pairs whose segments "
+        "traced back from the end of the step come within reach, approaching or not, merged "
+        "with their end-of-step state); the engine's default (each contact at the moment of "
+        "touching, approaching pairs only). The disk is chaotic, so the runs can agree merge "
+        "for merge only until round-off has grown; a merge counts as identical when the "
+        "same body is absorbed in the same step.")
+    lines.append("")
+    rows = []
+    for name, run in a["runs"].items():
+        same = {"rebound": "—", "end": a["identical_end"],
+                "contact": a["identical_contact"]}[name]
+        picks = [run["merges_by_step"][k] for k in range(4, len(a["marks"]), 10)]
+        rows.append([plots.ACCRETION_STYLE[name][0], run["merges"], same,
+                     ", ".join(map(str, picks)), run["bodies_left"],
+                     f"{run['largest_planetesimal'] / 1e-6:.0f}"])
+    marks = [a["marks"][k] for k in range(4, len(a["marks"]), 10)]
+    lines.append(table(["run", "merges", "first merges identical to REBOUND's",
+                        f"merges by step {', '.join(map(str, marks))}", "bodies left",
+                        "largest planetesimal (initial masses)"], rows))
+    lines.append("")
+    rows = []
+    for name in ("end", "contact"):
+        k = a[name + "_conservation"]
+        rows.append([plots.ACCRETION_STYLE[name][0], f(k["mass"]), f(k["momentum"]),
+                     f(k["charge"]), f(k["energy_without_ledger"]), f(k["energy_with_ledger"])])
+    lines.append(table(["engine run", "mass", "momentum (of sum m|v|)", "charge",
+                        "energy", "energy + ledger"], rows))
+    lines.append("")
+    lines.append(contact_findings(sec))
+    lines.append("")
+    return "\n".join(lines)
+
+
+def contact_findings(sec):
+    """The contact section's findings, from its figures."""
+    parts = []
+    for name, g in sec["gas"].items():
+        parts.append(
+            f"The {name} gas relaxes from KS p = {f(g['start_p'])} to p >= "
+            f"{f(min(g['p_values']))} against {'Rayleigh' if g['dim'] == 2 else 'Maxwell'}; "
+            f"its Z is {g['z']:.4f} against {g['z_expected']:.4f} "
+            f"({100 * (g['z'] / g['z_expected'] - 1):+.2f}%), energy kept to "
+            f"{f(g['energy_error'])}.")
+    a = sec["accretion"]
+    theirs = a["runs"]["rebound"]["merges"]
+    parts.append(
+        f"In the disk REBOUND merges {theirs} times; the engine's end-of-step run shares the "
+        f"first {a['identical_end']} of them and its default run the first "
+        f"{a['identical_contact']}"
+        + (" (found at the moment of contact, a merge can fall a step earlier than REBOUND's "
+           "end-of-step search finds it, and from then on the chaotic disk goes its own way)"
+           if a["identical_contact"] < theirs else "")
+        + "; merges over the whole run: "
+        f"{', '.join(str(r['merges']) for r in a['runs'].values())} (REBOUND, end, "
+        f"contact). Through them mass is kept to {f(a['contact_conservation']['mass'])}, "
+        f"momentum to {f(a['contact_conservation']['momentum'])} and charge to "
+        f"{f(a['contact_conservation']['charge'])}; the energy plus the ledger to "
+        f"{f(a['contact_conservation']['energy_with_ledger'])} (leapfrog's own error) where "
+        f"the energy alone changes by {f(a['contact_conservation']['energy_without_ledger'])}.")
+    return "**Findings.** " + " ".join(parts)
+
+
 def section_glance(res, level):
     """The headline numbers, each taken from the sections below."""
     lines = ["## At a glance", ""]
@@ -1060,6 +1177,14 @@ def section_glance(res, level):
         lines.append("- **Stiff spring, largest stable omega dt** (smallest over the stiffnesses "
                      "tried): " + ", ".join(cells) + "; so dt < 2/omega for leapfrog, Verlet and "
                      "symplectic Euler (section 5).")
+    if "contact" in res:
+        a = res["contact"]["accretion"]
+        zs = ", ".join(f"{name} Z {g['z']:.3f} against {g['z_expected']:.3f}"
+                       for name, g in res["contact"]["gas"].items())
+        lines.append(f"- **Contact**: hard-sphere gases relax to Maxwell-Boltzmann, {zs}; an "
+                     f"accreting disk merges as REBOUND's line search does, the first "
+                     f"{a['identical_end']} of {a['runs']['rebound']['merges']} merges identical "
+                     f"(section 7).")
     lines.append("")
     if "work_precision" in res:
         wp = res["work_precision"]
@@ -1140,6 +1265,8 @@ def write(out_dir, res, level):
     if "tree" in res:
         plots.tree_error(res["tree"], os.path.join(out_dir, "tree_error.png"))
         plots.tree_time(res["tree"], os.path.join(out_dir, "tree_time.png"))
+    if "contact" in res:
+        plots.contact(res["contact"], os.path.join(out_dir, "contact.png"))
     atomic_write(os.path.join(out_dir, "results.json"), json.dumps(jsonable(res), indent=1) + "\n")
     atomic_write(os.path.join(out_dir, "report.md"), markdown(res, level, figs))
 
@@ -1157,6 +1284,8 @@ def output_files(sections=SECTIONS):
     if "tree" in sections:
         files["tree_error.png"] = "png"
         files["tree_time.png"] = "png"
+    if "contact" in sections:
+        files["contact.png"] = "png"
     return files
 
 
@@ -1182,7 +1311,8 @@ def markdown(res, level, figs):
     parts.append("")
     parts.append("Contents: at a glance; 1. leapfrog cross-check with REBOUND; 2. two-body orbits; "
                  "3. energy drift; 4. work-precision (choosing an integrator); 5. hard cases; "
-                 "6. Tree gravity (FMM and Barnes-Hut).")
+                 "6. Tree gravity (FMM and Barnes-Hut); 7. Contact: a hard-sphere gas and an "
+                 "accreting disk.")
     parts.append("")
     parts.append(section_glance(res, level))
     if "crosscheck" in res:
@@ -1198,6 +1328,8 @@ def markdown(res, level, figs):
         parts.append(section_hard_cases(res["hard_cases"], "spring_limits.png"))
     if "tree" in res:
         parts.append(section_tree(res["tree"], "tree_error.png", "tree_time.png"))
+    if "contact" in res:
+        parts.append(section_contact(res["contact"], "contact.png"))
     parts.append("## Reproducing")
     parts.append("")
     parts.append("```\npython -m validation report --out docs/validation          # this report\n"

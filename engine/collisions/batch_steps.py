@@ -12,6 +12,7 @@ from numba import prange
 
 from ..batch import CHUNKS, step_system, system_model, system_state, system_workspace
 from ..cache import jit
+from .end_of_step import collide_at_end
 from .events import DONE, HALTED, MERGE, collide
 
 #: a system's status when a contact halted it, or when one step held too many contacts (the
@@ -56,10 +57,12 @@ def _restore(s, n, p0, v0, kept, merged):
 @jit(parallel=True, error_model="numpy")
 def advance_all_colliding(family, t, h, steps, state, model, vdep, tol, drifts, kicks, done,
                           status, resolve, restitution, points, normals, search, records,
-                          halts, merge_below):
+                          halts, merge_below, at_end):
     """Every system by ``steps`` steps, each followed by its contacts; ``records[m]`` gets
     system m's contact records, ``halts[m]`` (pair code i * n + j, time, speed) the contact
-    that halted it. ``t``, ``h``, ``done`` and ``status`` as ``engine.batch.advance_all``."""
+    that halted it; ``at_end``: contacts resolved at the end of the step
+    (``engine.collisions.end_of_step``), else at the moment of contact. ``t``, ``h``,
+    ``done`` and ``status`` as ``engine.batch.advance_all``."""
     systems = state.pos.shape[0]
     chunks = min(systems, CHUNKS)
     n = state.n
@@ -82,9 +85,14 @@ def advance_all_colliding(family, t, h, steps, state, model, vdep, tol, drifts, 
                 if sm != -1:
                     break
                 mark = len(record)
-                code, pair, t_hit, speed = collide(t_before, tm - t_before, s, model_m, p0, v0,
-                                                   resolve, restitution, points, normals,
-                                                   search, record, merge_below)
+                if at_end:
+                    code, pair, t_hit, speed = collide_at_end(
+                        t_before, tm - t_before, s, model_m, p0, v0, resolve, restitution,
+                        points, normals, search, record, merge_below)
+                else:
+                    code, pair, t_hit, speed = collide(
+                        t_before, tm - t_before, s, model_m, p0, v0, resolve, restitution,
+                        points, normals, search, record, merge_below)
                 if code != DONE:
                     _restore(s, n, p0, v0, kept, resolve == MERGE or merge_below > 0.0)
                     while len(record) > mark:

@@ -47,7 +47,7 @@ CONTACTS_PER_PARTICLE = 64
 
 
 @jit(error_model="numpy", inline="always")
-def _energy(t, state, model, out):
+def total_energy(t, state, model, out):
     """The state's total energy: kinetic of the moving particles plus every term's potential."""
     dim = state.pos.shape[0]
     kinetic = 0.0
@@ -81,7 +81,7 @@ def _search_again(events, X, D, anchor, radius, version, active, k, s0, box, poi
 
 
 @jit(error_model="numpy", inline="always")
-def _normal_speed_at(X, D, anchor, v0, v1, i, j, s, box):
+def closing_speed(X, D, anchor, v0, v1, i, j, s, box):
     """-u_n: how fast i and j close along their line of centres at fraction s (0 when their
     centres coincide)."""
     dx, dy, dz = separation(X, D, anchor, i, j, s, box)
@@ -154,17 +154,17 @@ def collide(t0, h, state, model, p0, v0, resolve, restitution, points, normals, 
             action = WALL
             j_record = j - n
         elif resolve == HALT:
-            return HALTED, i * n + j, t0 + s * h, _normal_speed_at(X, D, anchor, v0, v1, i, j,
+            return HALTED, i * n + j, t0 + s * h, closing_speed(X, D, anchor, v0, v1, i, j,
                                                                    s, box)
         elif resolve == MERGE or (merge_below > 0.0 and
-                                  _normal_speed_at(X, D, anchor, v0, v1, i, j, s, box) <
+                                  closing_speed(X, D, anchor, v0, v1, i, j, s, box) <
                                   merge_below):
             speed = relative_speed(v0, v1, i, j, s)
             keep, gone = survivor_of(pinned, i, j)
-            before = _energy(t0 + h, state, model, energies)
+            before = total_energy(t0 + h, state, model, energies)
             merge(X, D, anchor, v0, v1, pos, state.mass, state.charge, radius, pinned, active,
                   keep, gone, s, box)
-            energy = before - _energy(t0 + h, state, model, energies)
+            energy = before - total_energy(t0 + h, state, model, energies)
             touched = (keep, keep)
             action = MERGED
             j_record = j

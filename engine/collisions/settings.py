@@ -23,6 +23,10 @@ RESOLVE = ("bounce", "merge", "halt")
 #: how candidate pairs are found: every pair, a uniform grid of cells, or chosen from N
 SEARCH = ("auto", "direct", "grid")
 
+#: when a contact is resolved: at the moment the spheres touch (found along their paths), or
+#: at the end of the step as REBOUND does (``engine.collisions.end_of_step``)
+RESOLVE_AT = ("contact", "end")
+
 #: the codes the compiled kernels use (``RESOLVE`` and ``SEARCH`` by position)
 RESOLVE_CODES = {name: k for k, name in enumerate(RESOLVE)}
 SEARCH_CODES = {name: k for k, name in enumerate(SEARCH)}
@@ -113,12 +117,19 @@ class Collisions:
     - ``walls``: static planes (``Wall``, ``box_walls``) every particle bounces off;
     - ``search``: how candidate pairs are found: ``"direct"`` (every pair), ``"grid"`` (a
       uniform grid of cells as large as the largest distance a sphere sweeps in a step), or
-      ``"auto"`` (the grid from ``GRID_FROM`` active particles on).
+      ``"auto"`` (the grid from ``GRID_FROM`` active particles on);
+    - ``resolve_at``: ``"contact"`` (the default: each contact at the moment the spheres
+      touch, exact for force-free motion) or ``"end"`` (REBOUND's way, to compare with its
+      ``collision = "line"``: pairs that came within reach on the segments traced back from
+      the end of the step, resolved with their end-of-step state, approaching or not, by
+      the lower index then the higher: ``engine.collisions.end_of_step``; every pair is
+      tested, and there are no walls).
     """
 
     def __init__(self, resolve="bounce", restitution=1.0, walls=(), search="auto",
-                 merge_below=None):
+                 merge_below=None, resolve_at="contact"):
         resolve = one_of(*RESOLVE)("resolve", resolve)
+        resolve_at = one_of(*RESOLVE_AT)("resolve_at", resolve_at)
         if merge_below is not None:
             merge_below = finite_float("merge_below", merge_below)
             if merge_below < 0.0:
@@ -138,11 +149,19 @@ class Collisions:
         dims = {wall.dim for wall in walls}
         if len(dims) > 1:
             raise ValueError(f"walls must all have one dimension, got {sorted(dims)}")
+        if resolve_at == "end" and walls:
+            raise ValueError(f"resolve_at='end' resolves pairs as REBOUND does and has no "
+                             f"walls; got {len(walls)} walls (use resolve_at='contact')")
+        if resolve_at == "end" and search == "grid":
+            raise ValueError("resolve_at='end' tests every pair, as REBOUND's line search; "
+                             "got search='grid' (use search='auto' or 'direct', or "
+                             "resolve_at='contact')")
         self.resolve = resolve
         self.restitution = restitution
         self.walls = walls
         self.search = search
         self.merge_below = merge_below
+        self.resolve_at = resolve_at
 
     def wall_arrays(self, dim):
         """The walls' points and unit normals as two (3, W) arrays (z = 0 in 2-D)."""
@@ -158,7 +177,7 @@ class Collisions:
     def __repr__(self):
         return (f"Collisions(resolve={self.resolve!r}, restitution={self.restitution!r}, "
                 f"walls={len(self.walls)} walls, search={self.search!r}, "
-                f"merge_below={self.merge_below!r})")
+                f"merge_below={self.merge_below!r}, resolve_at={self.resolve_at!r})")
 
 
 def checked(value, dim):

@@ -206,6 +206,12 @@ def test_bad_input_is_refused_naming_the_value():
         Collisions(resolve="stick")
     with pytest.raises(ValueError, match="normal must not be zero"):
         Wall((0.0, 0.0), (0.0, 0.0))
+    with pytest.raises(ValueError, match="resolve_at.*'later'"):
+        Collisions(resolve_at="later")
+    with pytest.raises(ValueError, match="resolve_at='end'.*4 walls"):
+        Collisions(resolve_at="end", walls=box_walls(1.0, dim=2))
+    with pytest.raises(ValueError, match="resolve_at='end'.*search='grid'"):
+        Collisions(resolve_at="end", search="grid")
     sim = Simulation(dim=2)
     with pytest.raises(TypeError, match="collisions"):
         sim.collisions = "bounce"
@@ -346,8 +352,9 @@ def test_contacts_under_forces_converge_at_second_order_with_leapfrog():
 
 # -- a batch --------------------------------------------------------------------------------
 
-@pytest.mark.parametrize("resolve", ["bounce", "merge"])
-def test_a_batch_gives_each_system_the_contacts_and_bits_of_a_simulation(resolve):
+@pytest.mark.parametrize("resolve, resolve_at", [("bounce", "contact"), ("merge", "contact"),
+                                                 ("bounce", "end"), ("merge", "end")])
+def test_a_batch_gives_each_system_the_contacts_and_bits_of_a_simulation(resolve, resolve_at):
     from engine import Batch
 
     n, systems = 120, 3
@@ -356,11 +363,13 @@ def test_a_batch_gives_each_system_the_contacts_and_bits_of_a_simulation(resolve
     batch.add_many(mass=np.array([s.mass for s in scenes]), pos=np.array([s.pos for s in scenes]),
                    vel=np.array([s.vel for s in scenes]),
                    radius=np.array([s.radius for s in scenes]))
-    walls = box_walls(20.0, dim=2)
-    batch.collisions = Collisions(resolve=resolve, restitution=0.9, walls=walls)
+    walls = box_walls(20.0, dim=2) if resolve_at == "contact" else ()
+    batch.collisions = Collisions(resolve=resolve, restitution=0.9, walls=walls,
+                                  resolve_at=resolve_at)
     batch.step(30)
     for m, sim in enumerate(scenes):
-        sim.collisions = Collisions(resolve=resolve, restitution=0.9, walls=walls)
+        sim.collisions = Collisions(resolve=resolve, restitution=0.9, walls=walls,
+                                    resolve_at=resolve_at)
         sim.step(30)
         assert len(sim.contacts) > 5
         assert batch.contacts[m] == sim.contacts
@@ -385,6 +394,32 @@ def test_a_batch_system_that_halts_is_named_and_put_back():
     assert info.value.pair == (0, 1) and info.value.time == pytest.approx(2.5)
     assert batch.t.tolist() == [2.0, 4.0]  # system 0 stopped before its contact; 1 went on
     np.testing.assert_array_equal(batch.pos[0, :, 0], [-1.0, 1.0])
+
+
+def test_at_the_end_of_the_step_a_bounce_turns_the_end_velocities_and_halt_names_the_pair():
+    # head on, force-free, e = 0.5: they overlap at the end of the step (REBOUND's
+    # hardsphere bounce acts then, on the end velocities; the positions stay)
+    sim = Simulation(dim=3, integrator="leapfrog", dt=1.0)
+    sim.add(mass=1.0, pos=(-1.2, 0.0, 0.0), vel=(1.0, 0.0, 0.0), radius=0.5)
+    sim.add(mass=3.0, pos=(1.2, 0.0, 0.0), vel=(-1.0, 0.0, 0.0), radius=0.5)
+    sim.collisions = Collisions(restitution=0.5, resolve_at="end")
+    sim.step(1)
+    (c,) = sim.contacts
+    assert (c.time, c.i, c.j, c.action, c.speed) == (1.0, 0, 1, "bounce", 2.0)
+    np.testing.assert_array_equal(sim.pos[:, 0], [-1.2 + 1.0, 1.2 - 1.0])  # not moved
+    # u_n from -2 to +1: J = 3 / (1 + 1/3) = 2.25
+    np.testing.assert_allclose(sim.vel[:, 0], [1.0 - 2.25, -1.0 + 0.75], rtol=1e-15)
+    assert c.energy == pytest.approx(0.5 * 0.75 * 4.0 * 0.75, rel=1e-15)
+    sim.step(1)  # separating now: no contact although they still overlap
+    assert sim.contacts == ()
+    halting = Simulation(dim=3, integrator="leapfrog", dt=1.0)
+    halting.add(mass=1.0, pos=(-1.2, 0.0, 0.0), vel=(1.0, 0.0, 0.0), radius=0.5)
+    halting.add(mass=3.0, pos=(1.2, 0.0, 0.0), vel=(-1.0, 0.0, 0.0), radius=0.5)
+    halting.collisions = Collisions(resolve="halt", resolve_at="end")
+    with pytest.raises(Collision) as info:
+        halting.step(1)
+    assert info.value.pair == (0, 1) and info.value.time == 1.0 and info.value.speed == 2.0
+    assert halting.t == 0.0 and halting.pos[0, 0] == -1.2
 
 
 def test_merge_below_merges_the_slow_contacts_and_bounces_the_fast():

@@ -171,13 +171,17 @@ def test_report_smoke_writes_its_files(tmp_path, rebound):
     assert report.main(["--out", str(tmp_path), "--smoke", "--workers", "1", "--no-progress"]) == 0
     md = (tmp_path / "report.md").read_text()
     data = json.loads((tmp_path / "results.json").read_text())
-    for section in ("crosscheck", "two_body", "energy_drift", "work_precision", "hard_cases"):
+    for section in ("crosscheck", "two_body", "energy_drift", "work_precision", "hard_cases",
+                    "contact"):
         assert section in data
     for png in ("two_body_convergence.png", "two_body_growth.png", "energy_drift.png",
-                "spring_limits.png", "work_precision_kepler_e0.6.png"):
+                "spring_limits.png", "work_precision_kepler_e0.6.png", "contact.png"):
         assert (tmp_path / png).stat().st_size > 10_000
         assert f"]({png})" in md
     assert "## 5. Hard cases" in md
+    assert "## 7. Contact" in md
+    accretion = data["contact"]["accretion"]
+    assert accretion["runs"]["end"]["merges"] == accretion["runs"]["rebound"]["merges"] > 0
 
 
 def test_main_dispatches_report_without_importing_bench():
