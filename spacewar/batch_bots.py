@@ -3,7 +3,7 @@
 A batch bot is any object with ``act_batch(self, obs) -> codes``:
 
 - ``obs`` is a (K, D) float32 array, one learning observation per match
-  (``spacewar.learning.learning_layout(rules)`` names the D entries: egocentric, scaled to
+  (``spacewar.features.learning_layout(rules)`` names the D entries: egocentric, scaled to
   about [-1, 1]; the same numbers ``spacewar.envs`` gives learning code);
 - ``codes`` is K game action codes, integers in [0, ``spacewar.codes.N_ACTIONS``) (``turn + 1
   + 3 thrust + 6 fire + 12 hyperspace + 24 flip``; ``spacewar.envs.codes_from_parts`` turns
@@ -25,7 +25,6 @@ A NumPy or PyTorch policy so plays hundreds of matches in one forward pass.
 import numpy as np
 
 from . import codes
-from . import wire
 from .wire import INVALID, MEMORY, OK, RAISED, exception_text
 
 
@@ -92,12 +91,12 @@ def one_match_bot(bot, rules, rounds):
 
 class SingleFromBatch:
     """A batch bot playing one match: ``act(obs)`` asks ``act_batch`` with K = 1 on the
-    learning observation of the ``Observation`` it gets (``spacewar.learning.learning_vector``
+    learning observation of the ``Observation`` it gets (``spacewar.features.learning_vector``
     of its raw numbers). ``rounds`` is the match's (the learning observation scales the
     score and round count by it)."""
 
     def __init__(self, bot, rules, rounds):
-        from .learning import learning_vector  # imported now, in the bot's start-up time
+        from .features import learning_vector  # imported now, in the bot's start-up time
 
         self.bot = bot
         self.rules = rules
@@ -110,7 +109,7 @@ class SingleFromBatch:
             reset()
 
     def answer(self, obs):
-        """``(status, code, text)`` as ``spacewar.wire.ask`` gives for a bot with ``act``."""
+        """``(status, code, text)`` as ``spacewar.ask.ask`` gives for a bot with ``act``."""
         row = self._vector(obs.raw(), self.rules, self.rounds)[None]
         status, answer, text = ask_batch(self.bot, row)
         return status, int(answer[0]), text
@@ -124,7 +123,5 @@ class SingleFromBatch:
             raise ValueError(f"act_batch failed: {text}")
         return Action.from_code(code)
 
-
-wire._SINGLE_FROM_BATCH[0] = SingleFromBatch  # what wire.ask answers for with bot.answer
 
 __all__ = ["is_batch_bot", "ask_batch", "checked_codes", "one_match_bot", "SingleFromBatch"]

@@ -36,12 +36,14 @@ from . import core
 from .batch_bots import ask_batch, is_batch_bot
 from .bots import declares_act_batch, is_builtin, is_policy_file
 from .game import Game
-from .learning import learning_length
-from .match import (DEFAULT_BUDGET, DEFAULT_MAX_FAULTS, FaultLog, _cpu_seconds, _result,
+from .features import learning_length
+from .match import (DEFAULT_BUDGET, DEFAULT_MAX_FAULTS, cpu_seconds, match_result,
                     act_time_summary, bot_seed, checked_limits)
 from .protocol import raw_length
 from .rules import Rules, count_at_least
-from .seats import _KIND_BY_STATUS, FAULT_KINDS, BatchProcessSeat, _Bank, bot_name, open_seat
+from .faults import KIND_BY_STATUS
+from .referee import Referee
+from .seats import BatchProcessSeat, TimeBank, bot_name, open_seat
 from .wire import INVALID, MAX_ROWS, OK, exception_text
 
 
@@ -91,7 +93,7 @@ class _BatchSide:
             return
         try:
             if isinstance(spec, str):
-                from .policy import PolicyBatch
+                from .bots.policy import PolicyBatch
 
                 self.bot = PolicyBatch(spec, rules, [s for _, s in rows])
             reset = getattr(self.bot, "reset", None)
@@ -144,13 +146,11 @@ def play_matches(matches, rounds=5, rules=None, budget=DEFAULT_BUDGET,
                              f"together; {spec!r} has {rows}")
     count = len(matches)
     game = Game(rules, seeds=[seed for _, _, seed in matches], rounds=rounds)
-    faults = [[FaultLog(), FaultLog()] for _ in range(count)]
-    forfeits = np.zeros((count, 2), dtype=bool)
-    banks = [[_Bank(limits), _Bank(limits)] for _ in range(count)]
+    referees = [Referee(max_faults, record) for _ in range(count)]
+    banks = [[TimeBank(limits), TimeBank(limits)] for _ in range(count)]
     sides, seats = _open(matches, limits, rules, rounds, batch_files)
-    tape = _Tape(count) if record else None
     try:
-        wall = _play(game, sides, seats, faults, forfeits, banks, max_faults, tape)
+        wall = _play(game, sides, seats, referees, banks)
     finally:
         outputs = [[None, None] for _ in range(count)]
         for m, row in enumerate(seats):
@@ -163,8 +163,9 @@ def play_matches(matches, rounds=5, rules=None, budget=DEFAULT_BUDGET,
                 outputs[m][s] = output
     out = []
     for m, (p1, p2, seed) in enumerate(matches):
-        result = _result(game, (bot_name(p1), bot_name(p2)), seed, rounds, rules, faults[m],
-                         forfeits[m].tolist(), outputs[m], m=m)
+        referee = referees[m]
+        result = match_result(game, (bot_name(p1), bot_name(p2)), seed, rounds, rules,
+                              referee.faults, referee.forfeits, outputs[m], m=m)
         times = _act_times(m, sides, seats)
         timing = {"wall_seconds": wall / count,
                   "frames_per_second": result["steps"] / max(wall / count, 1e-9),
@@ -172,7 +173,11 @@ def play_matches(matches, rounds=5, rules=None, budget=DEFAULT_BUDGET,
         if act_seconds:
             timing["act_seconds"] = times
         if record:
-            out.append((result, tape.replay(game, m, result, max_faults), timing))
+            from .replay import make_replay
+
+            replay = make_replay(result, bytes(referee.history), _final_hash(game, m, result),
+                                 faults=bytes(referee.fault_codes), max_faults=max_faults)
+            out.append((result, replay, timing))
         else:
             out.append((result, timing))
     return out
@@ -191,39 +196,6 @@ def _act_times(m, sides, seats):
     return [np.frombuffer(t, dtype=np.float64).copy() for t in times]
 
 
-class _Tape:
-    """What ``play_match`` records of each match, kept for all of them: two action codes
-    per frame played, and two fault-kind codes (0 none, 1 + ``FAULT_KINDS`` index) per frame
-    asked, the frame a match forfeits on included."""
-
-    def __init__(self, count):
-        self.actions = [bytearray() for _ in range(count)]
-        self.faults = [bytearray() for _ in range(count)]
-        self._before = None
-
-    def asking(self, faults, live):
-        """Before a frame's questions: each live match's fault counts, to see what is new."""
-        self._before = {int(m): (faults[m][0].total, faults[m][1].total)
-                        for m in np.flatnonzero(live)}
-
-    def asked(self, faults, forfeits, actions):
-        """After them: each live match's new faults, and its actions when it plays the frame."""
-        for m, totals in self._before.items():
-            kinds = [0, 0]
-            for s in range(2):
-                if faults[m][s].total > totals[s]:  # one question a frame: at most one fault
-                    kinds[s] = 1 + FAULT_KINDS.index(faults[m][s].last["kind"])
-            self.faults[m] += bytes(kinds)
-            if not forfeits[m].any():
-                self.actions[m] += bytes((int(actions[m, 0]), int(actions[m, 1])))
-
-    def replay(self, game, m, result, max_faults):
-        from .replay import make_replay
-
-        return make_replay(result, bytes(self.actions[m]), _final_hash(game, m, result),
-                           faults=bytes(self.faults[m]), max_faults=max_faults)
-
-
 def _final_hash(game, m, result):
     """Match ``m``'s final state hash as ``play_match`` (and a replay's check) sees it: a
     match that stopped on a forfeit was marked over here only to be stepped no more, while
@@ -238,24 +210,25 @@ def _final_hash(game, m, result):
         match_state[m, core.OVER] = 1
 
 
-def _play(game, sides, seats, faults, forfeits, banks, max_faults, tape=None):
-    """Play every match to its end or its forfeit; return the wall-clock seconds. ``tape``
-    (a ``_Tape``) records what each match's replay needs."""
+def _play(game, sides, seats, referees, banks):
+    """Play every match to its end or its forfeit, each judged by its referee
+    (``spacewar.referee``: faults, forfeits, and what its replay needs); return the
+    wall-clock seconds."""
     count = len(seats)
     for side in sides:
         if side.wait_ready() is not None:
             for m, s in side.rows:
-                faults[m][s].add(0, *side.dead)
-                forfeits[m, s] = True
+                referees[m].could_not_start(s, side.dead)
     for m, row in enumerate(seats):
         for s, seat in enumerate(row):
             if seat is not None and seat.wait_ready() is not None:
-                faults[m][s].add(0, *seat.dead)
-                forfeits[m, s] = True
+                referees[m].could_not_start(s, seat.dead)
     match_state = game.match_state
     # a match whose seat forfeits stops where it is, as a match alone stops: over, so that
     # the game steps it no more and the loop below asks nothing of it
-    match_state[forfeits.any(axis=1), core.OVER] = 1
+    for m, referee in enumerate(referees):
+        if referee.forfeited:
+            match_state[m, core.OVER] = 1
     actions = np.full((count, 2), core.NOOP, dtype=np.int64)
     raw = np.empty(raw_length(game.rules))
     learning = (np.zeros((count, 2, learning_length(game.rules)), dtype=np.float32)
@@ -266,28 +239,23 @@ def _play(game, sides, seats, faults, forfeits, banks, max_faults, tape=None):
     while live.any():
         if learning is not None:
             game.learning_observations(learning)
-        if tape is not None:
-            tape.asking(faults, live)
         for side in sides:
-            _ask_side(side, call, learning, live, match_state, actions, faults, banks, forfeits)
+            _ask_side(side, call, learning, live, match_state, actions, referees, banks)
         call += 1
         for m in np.flatnonzero(live):
+            referee = referees[m]
+            frame = int(match_state[m, core.FRAME])
             for s, seat in enumerate(seats[m]):
                 if seat is None:
                     continue
-                code, fault = seat.act(game._write_raw(int(m), s, raw))
+                code, fault = seat.act(game.write_raw(int(m), s, raw))
                 actions[m, s] = code
-                if fault is not None:
-                    faults[m][s].add(int(match_state[m, core.FRAME]), *fault)
-        for m in np.flatnonzero(live):
-            for s in range(2):
-                if faults[m][s].total >= max_faults:
-                    forfeits[m, s] = True
-            if forfeits[m].any():
+                referee.judge(s, frame, fault, seat.dead is not None)
+            if referee.questions_done():
                 match_state[m, core.OVER] = 1
-        if tape is not None:
-            tape.asked(faults, forfeits, actions)
-        game._step_codes(actions)  # codes from the checks above: valid
+            else:
+                referee.played(actions[m, 0], actions[m, 1])
+        game.step_codes(actions)  # codes from the checks above: valid
         live = match_state[:, core.OVER] == 0
     return time.perf_counter() - start
 
@@ -305,7 +273,7 @@ def _open(matches, limits, rules, rounds, batch_files):
     """The batch sides (one per distinct batch bot) and the per-match seats of the others."""
     sides = {}
     seats = [[None, None] for _ in matches]
-    cpu = _cpu_seconds(rules, rounds, limits)
+    cpu = cpu_seconds(rules, rounds, limits)
     for m, (p1, p2, seed) in enumerate(matches):
         for s, spec in enumerate((p1, p2)):
             if is_batch_spec(spec, batch_files):
@@ -324,7 +292,7 @@ def _open(matches, limits, rules, rounds, batch_files):
     return out, seats
 
 
-def _ask_side(side, call, learning, live, match_state, actions, faults, banks, forfeits):
+def _ask_side(side, call, learning, live, match_state, actions, referees, banks):
     """The batch bot's codes for all its rows (a no-op and a fault on each live row when its
     answer is not usable), judged in the order of a match alone (``InlineSeat.act``): no
     answer at all (raised, out of memory) costs no time; a late answer is a timeout, whatever
@@ -355,18 +323,16 @@ def _ask_side(side, call, learning, live, match_state, actions, faults, banks, f
         if share is not None:
             side.act_seconds[k].append(share)
         if fault is not None:  # its process gave no answer
-            faults[m][s].add(frame, *fault)
-            if side.dead is not None:
-                forfeits[m, s] = True
-            elif share is not None:  # silent for the whole allowance: every bank is spent
-                banks[m][s].left = 0.0
-        elif side.seat is None and status in _KIND_BY_STATUS and status != INVALID:
+            referees[m].judge(s, frame, fault, side.dead is not None)
+            if side.dead is None and share is not None:
+                banks[m][s].left = 0.0  # silent for the whole allowance: every bank is spent
+        elif side.seat is None and status in KIND_BY_STATUS and status != INVALID:
             # no answer at all from code in this process; a confined bot's status is its own word
-            faults[m][s].add(frame, _KIND_BY_STATUS[status], text)
+            referees[m].judge(s, frame, (KIND_BY_STATUS[status], text))
         elif not banks[m][s].charge(share):
-            faults[m][s].add(frame, "timeout", banks[m][s].late(share))
+            referees[m].judge(s, frame, ("timeout", banks[m][s].late(share)))
         elif status != OK:
-            faults[m][s].add(frame, _KIND_BY_STATUS[status], text)
+            referees[m].judge(s, frame, (KIND_BY_STATUS[status], text))
         else:
             actions[m, s] = codes[k]
 

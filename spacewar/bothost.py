@@ -17,6 +17,7 @@ import os
 import sys
 
 from . import wire
+from .ask import ask
 from .protocol import observation_of_copy, raw_length
 
 
@@ -120,7 +121,7 @@ def _answer(bot, rules, frame, raw):
     of this process's own, which the observation keeps)."""
     if raw.shape != (raw_length(rules),):
         raise wire.WireError(f"observation of {raw.size} numbers, {raw_length(rules)} expected")
-    status, code, text = wire.ask(bot, observation_of_copy(raw, rules))
+    status, code, text = ask(bot, observation_of_copy(raw, rules))
     return wire.pack_answer(frame, status, code, text)
 
 

@@ -32,9 +32,10 @@ import json
 import numpy as np
 
 from .bots import BotLoadError, available, locate
-from .match import DEFAULT_MAX_FAULTS, _check_bot_argument, act_time_summary, play_match
+from .match import DEFAULT_MAX_FAULTS, check_bot_argument, act_time_summary, play_match
 from .rules import Rules, count_at_least
-from .seats import FAULT_KINDS, Limits, bot_name, printable
+from .faults import FAULT_KINDS, printable
+from .seats import Limits, bot_name
 
 #: a p99 action time above this fraction of the budget is a warning (little headroom)
 HEADROOM = 0.5
@@ -175,7 +176,7 @@ def check_bot(bot, *, opponents=None, games=None, seed=0, rounds=1, rules=None, 
 def _checked_arguments(bot, opponents, games, seed, rounds, rules, limits, max_faults,
                        isolation):
     """The opponents, rules and limits to play with, after checking every argument."""
-    _check_bot_argument("bot", bot)
+    check_bot_argument("bot", bot)
     count_at_least("games", games, 1)
     count_at_least("seed", seed, 0)
     count_at_least("rounds", rounds, 1)
@@ -209,8 +210,8 @@ def _schedule(opponents, games, seed):
 
 def _batch_files(bot, opponents):
     """The bots from files among ``bot`` and ``opponents`` that a tournament plays as batch
-    bots (``tournament.batch_files_of``); none are run to find out."""
-    from .tournament import batch_files_of
+    bots (``jobs.batch_files_of``); none are run to find out."""
+    from .jobs import batch_files_of
 
     return batch_files_of([x for x in [bot, *opponents] if isinstance(x, str)])
 
@@ -226,10 +227,10 @@ def _plays_together(bot, batch_files, isolation):
 
 
 def _jobs(bot, opponents, games, seed, isolation, batch_files):
-    """The schedule cut as a tournament cuts its own (``tournament.group_jobs``): a list of
+    """The schedule cut as a tournament cuts its own (``jobs.group_jobs``): a list of
     ``(entries, together)``, ``entries`` the ``(opponent, seed, seat)`` of each match of a
     job, ``together`` whether they are played in one game (``batch_match.play_matches``)."""
-    from .tournament import group_jobs
+    from .jobs import group_jobs
 
     schedule = _schedule(opponents, games, seed)
     if not isinstance(bot, str):

@@ -336,7 +336,7 @@ def _add_author_commands(sub, fmt):
 def _describe_match(result, timing):
     """A match's result as text, every line escaped (``seats.printable``): the bots' names
     are submissions' file names, and their fault messages their own words."""
-    from .seats import FAULT_KINDS, printable
+    from .faults import FAULT_KINDS, printable
 
     p1, p2 = result["bots"]
     a, b = result["score"]
@@ -403,7 +403,7 @@ def _check_policy_files(specs):
     """A policy file named on the command line that cannot be played is an error now (exit 2,
     with the field at fault), not a forfeit after the match starts."""
     from .bots import BotLoadError, is_policy_file
-    from .policy import Policy, PolicyError
+    from .bots.policy import Policy, PolicyError
 
     for spec in specs:
         if is_policy_file(spec):
@@ -439,8 +439,8 @@ def _cmd_league(args):
     import os
 
     from .bots import bots_in
-    from .league import format_table, run_league
-    from .seats import printable
+    from .league import format_standings, run_league
+    from .faults import printable
 
     if os.path.isdir(args.bots):
         bots, skipped = bots_in(args.bots)
@@ -470,7 +470,7 @@ def _cmd_league(args):
         print(f"League: {len(bots)} bots, {results['rounds_played']} {args.pairing} rounds, "
               f"{matches} matches of {args.match_rounds} rounds, seed {args.seed}; "
               f"results in {args.out}")
-        print(format_table(results))
+        print(format_standings(results))
     return 0
 
 
@@ -609,7 +609,7 @@ def _cmd_compile(args):
 
 def _cmd_check(args):
     from .checker import check_bot
-    from .seats import printable
+    from .faults import printable
 
     def show(match):
         again = " (the same match again)" if match.get("repeat") else ""
@@ -638,7 +638,7 @@ def main(argv=None):
     args = build_parser().parse_args(argv)
     from .bots import BotLoadError
     from .replay import ReplayError
-    from .seats import printable
+    from .faults import printable
     from engine.cluster import CodeMismatch, SchedulerUnreachable
 
     try:

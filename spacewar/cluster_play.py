@@ -1,7 +1,7 @@
 """Tournament and league matches on a Dask cluster (``engine.cluster``).
 
 The matches of a run are cut into tasks of many matches each; a task plays its matches on the
-worker exactly as a local worker process would (``spacewar.tournament._play``: every bot that
+worker exactly as a local worker process would (``spacewar.jobs.play_job``: every bot that
 is not built in in its own confined process, with the same limits), so the results are the
 same, and they are put back in schedule order.
 
@@ -27,7 +27,7 @@ import tempfile
 from engine import cluster
 
 from . import confinement
-from .bots import BotLoadError, _is_file_spec, _split, is_builtin, is_policy_file
+from .bots import BotLoadError, is_builtin, is_file_spec, is_policy_file, split_spec
 from .seats import sweep_stale_directories
 from .strangers_files import FileRefused, read_bounded
 
@@ -45,8 +45,8 @@ def bot_files(bots):
         elif is_builtin(spec):
             continue
         else:
-            where, _ = _split(spec)
-            if not _is_file_spec(where):
+            where, _ = split_spec(spec)
+            if not is_file_spec(where):
                 raise BotLoadError(
                     f"bot {spec!r} is a module: on a cluster only built-in bots and bots from "
                     "files can play (a module would have to be installed on every worker); "
@@ -131,10 +131,10 @@ def _named_by_seat(result, pair):
 
 
 def play_chunk(task, fingerprint):
-    """A task: the outcomes of each job of ``task = (jobs, files)`` (``tournament._play``),
+    """A task: the outcomes of each job of ``task = (jobs, files)`` (``jobs.play_job``),
     with the client's bot names; ``files`` holds the bots from files those jobs play."""
     cluster.check_code(fingerprint)
-    from .tournament import _play
+    from .jobs import play_job
 
     jobs, files = task
     out = []
@@ -143,7 +143,7 @@ def play_chunk(task, fingerprint):
             rest = list(rest)
             rest[-1] = frozenset(local.get(s, s) for s in rest[-1])  # batch_files
             mine = [(local.get(p1, p1), local.get(p2, p2), seed) for p1, p2, seed in matches]
-            outcomes = _play((mine, together, *rest))
+            outcomes = play_job((mine, together, *rest))
             for (result, _), (p1, p2, _) in zip(outcomes, matches, strict=True):
                 _named_by_seat(result, (p1, p2))
             out.append(outcomes)
@@ -162,7 +162,7 @@ class _GameConnection:
 
     def __init__(self, address, bots):
         self.files = bot_files(bots)
-        self.connection = cluster.Connection(address, warm=("spacewar.tournament:warm_up_game",))
+        self.connection = cluster.Connection(address, warm=("spacewar.jobs:warm_up_game",))
 
     def close(self):
         self.connection.close()

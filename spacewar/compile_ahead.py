@@ -26,7 +26,7 @@ def match_frame():
 
 def batch_frame():
     """One frame of a batch of matches, as a tournament's worker plays them."""
-    from .tournament import warm_up_game
+    from .jobs import warm_up_game
 
     warm_up_game()
 

@@ -87,12 +87,14 @@ from engine.cache import jit_disabled, numpy_dot_kind
 from engine.analytic import kepler_step
 
 from . import core
+from .builtin_bots import NAMES
 
 jit = core.jit
 
-#: the compiled bots by name, as ``decide``'s ``kind``
-KINDS = {"idle": 0, "random": 1, "chaser": 2, "sniper": 3, "dodger": 4}
-IDLE, RANDOM, CHASER, SNIPER, DODGER = 0, 1, 2, 3, 4
+#: the compiled bots by name, as ``decide``'s ``kind`` (``spacewar.builtin_bots``' order)
+KINDS = {name: k for k, name in enumerate(NAMES)}
+IDLE, RANDOM, CHASER, SNIPER, DODGER = (KINDS[name] for name in
+                                        ("idle", "random", "chaser", "sniper", "dodger"))
 
 # memory per seat (see the module docstring)
 (ESCAPING, THRUST_X, THRUST_Y, HAS_LAST, LAST_ROUND, LAST_ROUND_FRAME, LAST_X, LAST_Y, LAST_VX,

@@ -19,7 +19,7 @@ Action space
     ``action_type="discrete"``: ``Discrete(24)`` (48 in the electric mode), the game's own
     action code ``turn + 3 thrust + 6 fire + 12 hyperspace + 24 flip``.
 Observation space
-    ``Box`` of float32, shape (D,): ``spacewar.learning.learning_layout(rules)`` names the
+    ``Box`` of float32, shape (D,): ``spacewar.features.learning_layout(rules)`` names the
     entries (egocentric, scaled to about [-1, 1]; see docs/game.md). Relative positions, headings,
     fractions and flags have their exact bounds; velocities are unbounded (thrust has no limit).
 Rewards
@@ -66,7 +66,7 @@ except ImportError as error:  # pragma: no cover - the extra is missing
 from . import core
 from .codes import codes_from_parts
 from .learning import LearningBatch, copy_rows, learning_layout, learning_length, seat_kinds
-from .learning import compiled_bots
+from . import compiled_bots
 from .batch_bots import checked_codes
 from .protocol import action_code
 from .rules import Rules, count_at_least
@@ -127,7 +127,7 @@ class _Opponent:
         if opponent is None or isinstance(opponent, str) and opponent in compiled_bots.KINDS:
             self.compiled = opponent
         elif isinstance(opponent, (str, os.PathLike)) and is_policy_file(os.fspath(opponent)):
-            from .policy import PolicyBatch
+            from .bots.policy import PolicyBatch
 
             # seat 1's rows, each held frame_skip frames: as PolicyBot plays each match
             self.policy = PolicyBatch(os.fspath(opponent), rules, np.ones(num_envs, np.int64))
@@ -374,7 +374,7 @@ class SpacewarEnv(gymnasium.Env):
         return None
 
     def _draw_window(self, prims):
-        from .play import _paint, require_pygame
+        from .viewer import paint, require_pygame
 
         pygame = require_pygame()
         if self._screen is None:
@@ -384,13 +384,13 @@ class SpacewarEnv(gymnasium.Env):
             self._clock = pygame.time.Clock()
             self._fonts = {}
         pygame.event.pump()
-        _paint(pygame, self._screen, prims, self._fonts)
+        paint(pygame, self._screen, prims, self._fonts)
         pygame.display.flip()
         self._clock.tick(self.metadata["render_fps"])
 
     def close(self):
         if self._screen is not None:
-            from .play import require_pygame
+            from .viewer import require_pygame
 
             require_pygame().display.quit()
             self._screen = None

@@ -19,7 +19,7 @@ import numpy as np
 
 from engine import Batch, forces
 
-from . import core
+from . import core, features
 from .protocol import Action, observation_from_raw, raw_length
 from .rules import Rules, count_at_least
 
@@ -156,9 +156,9 @@ class Game:
         self._actions = np.full((m, 2), core.NOOP, dtype=np.int64)
         core.reset_all(self.pos, self.vel, self.mass, self.charge, self.active, self.ship_gauges,
                        self.ship_counters, self.torp_life, self.match_state, self.rules_vector)
-        self._frame_arguments = self._gather_frame_arguments()
+        self.frame_arguments = self.gather_frame_arguments()
 
-    def _sync_with_batch(self):
+    def sync_with_batch(self):
         """Follow a re-pack of the batch (a term's attribute changed, a term or slots added):
         its parameter rows are then a new array, with the thrust at new columns, and the frame
         must write into and step with those, never a stale copy."""
@@ -168,9 +168,9 @@ class Game:
         self.rules_vector[core.R_THRUST_OFF] = self.batch.parameter_columns(self.terms[-1],
                                                                             "force")[0]
         self._revision = self.batch.revision
-        self._frame_arguments = self._gather_frame_arguments()
+        self.frame_arguments = self.gather_frame_arguments()
 
-    def _gather_frame_arguments(self):
+    def gather_frame_arguments(self):
         """What the compiled frame takes after the actions, gathered once (and again after a
         re-pack), not per frame."""
         return (*self.state, *self.model, self.ship_gauges, self.ship_counters, self.torp_life,
@@ -194,23 +194,23 @@ class Game:
         if actions is None:
             self._actions[:] = core.NOOP
         else:
-            self._actions[:] = self._encode(actions)
-        self._sync_with_batch()
-        core.step_all(self._actions, *self._frame_arguments)
+            self._actions[:] = self.encode_actions(actions)
+        self.sync_with_batch()
+        core.step_all(self._actions, *self.frame_arguments)
 
-    def _step_codes(self, codes):
+    def step_codes(self, codes):
         """``step`` with (M, 2) int64 action codes the caller has already checked (the match
         loop's, which come from ``protocol.action_code``): no conversion, no checks."""
-        self._sync_with_batch()
-        core.step_all(codes, *self._frame_arguments)
+        self.sync_with_batch()
+        core.step_all(codes, *self.frame_arguments)
 
-    def _step_one_codes(self, m, codes, raws):
-        """``_step_codes`` for match m alone, which also writes what each seat sees next into
+    def step_one_codes(self, m, codes, raws):
+        """``step_codes`` for match m alone, which also writes what each seat sees next into
         ``raws`` (2, ``raw_length``): the match loop's one compiled call per frame."""
-        self._sync_with_batch()
-        core.step_one_and_observe(codes, *self._frame_arguments, m, raws)
+        self.sync_with_batch()
+        core.step_one_and_observe(codes, *self.frame_arguments, m, raws)
 
-    def _write_raw(self, m, seat, out):
+    def write_raw(self, m, seat, out):
         """``raw_observation(m, seat, out)`` for a caller that owns a right ``out``."""
         state = self.state
         core.write_observation(m, seat, state.pos, state.vel, state.charge, state.active,
@@ -218,7 +218,7 @@ class Game:
                                self.match_state, self.rules_vector, out)
         return out
 
-    def _encode(self, actions):
+    def encode_actions(self, actions):
         if isinstance(actions, np.ndarray) and actions.dtype.kind in "iu":
             codes = actions
         else:
@@ -270,11 +270,10 @@ class Game:
 
     def learning_observations(self, out=None):
         """Every match's two seats as learning observations, (M, 2, D) float32, written by
-        compiled code into ``out`` if given (``spacewar.learning.learning_layout`` names the
+        compiled code into ``out`` if given (``spacewar.features.learning_layout`` names the
         D entries)."""
-        from . import learning
 
-        shape = (self.n_matches, 2, learning.learning_length(self.rules))
+        shape = (self.n_matches, 2, features.learning_length(self.rules))
         if out is None:
             out = np.empty(shape, dtype=np.float32)
         elif (not isinstance(out, np.ndarray) or out.dtype != np.float32 or out.shape != shape
@@ -283,8 +282,8 @@ class Game:
                              f"got {type(out).__name__} {getattr(out, 'dtype', '')} "
                              f"{getattr(out, 'shape', '')}")
         if getattr(self, "_learning_scales", None) is None:
-            self._learning_scales = learning.learning_scales(self.rules, self.rounds)
-        learning.write_all_learning(self.pos, self.vel, self.charge, self.active,
+            self._learning_scales = features.learning_scales(self.rules, self.rounds)
+        features.write_all_learning(self.pos, self.vel, self.charge, self.active,
                                     self.ship_gauges, self.ship_counters, self.torp_life,
                                     self.match_state, self.rules_vector, self._learning_scales, out)
         return out
@@ -292,9 +291,7 @@ class Game:
     def learning_observation(self, m, seat):
         """One seat's learning observation computed in NumPy from the observation a bot gets
         (``raw_observation``): the reference for ``learning_observations``."""
-        from .learning import learning_vector
-
-        return learning_vector(self.raw_observation(m, seat), self.rules, self.rounds)
+        return features.learning_vector(self.raw_observation(m, seat), self.rules, self.rounds)
 
     def observe(self, m, seat):
         """The observation of match ``m`` from seat ``seat``'s side: a fresh object whose arrays
@@ -361,7 +358,7 @@ class Game:
         ship); ``spacewar.timeline`` keeps a bounded number of them to scrub a replay.
         """
         m = self._match_index(m)
-        self._sync_with_batch()
+        self.sync_with_batch()
         arrays = []
         for row in self._match_rows(m):
             copy = row.copy()
@@ -378,7 +375,7 @@ class Game:
             raise TypeError(f"checkpoint must be a spacewar.game.Checkpoint (from "
                             f"Game.checkpoint), got {type(checkpoint).__name__}")
         m = self._match_index(m)
-        self._sync_with_batch()
+        self.sync_with_batch()
         if checkpoint.layout != self._layout():
             raise ValueError(f"checkpoint of frame {checkpoint.frame} was taken in a game with "
                              "other rules, rounds or force layout; it cannot be restored here")

@@ -47,9 +47,11 @@ import numpy as np
 
 from .match import DEFAULT_BUDGET, DEFAULT_MAX_FAULTS
 from .rules import Rules
-from .seats import Limits, printable
+from .faults import printable
+from .seats import Limits
 from .strangers_files import FileRefused, read_bounded
-from .tournament import MatchRunner, _progress, batch_files_of, make_jobs, match_record
+from .jobs import batch_files_of, make_jobs, match_record
+from .runner import MatchRunner, progress_bar
 
 FORMAT = "spacewar-league"
 VERSION = 1
@@ -510,7 +512,7 @@ def _check_count(path, where, field, value, high):
 
 
 def _check_outcome(path, where, match):
-    """``forfeit`` and ``winner`` are what ``match._result`` gives for the record's score and
+    """``forfeit`` and ``winner`` are what ``match.match_result`` gives for the record's score and
     forfeits: one forfeit names its seat's bot and the other bot wins; two forfeits, or
     none and an equal score, are a draw; otherwise the higher score wins, or nobody when the
     simulation stopped on a numerical error (which the record does not keep)."""
@@ -577,7 +579,7 @@ def run_league(bots, rounds, out, games=2, pairing="swiss", seed=1, match_rounds
                               f"than rounds={rounds}: ask for at least {len(done)}")
     batch_files = batch_files_of(bots)
     per_round = 2 * games * (len(bots) // 2)
-    bar = _progress(per_round * (rounds - len(done)), progress, "league")
+    bar = progress_bar(per_round * (rounds - len(done)), progress, "league")
     try:
         with MatchRunner(bots, rules, workers, scheduler) as runner:
             while len(done) < rounds:
@@ -608,7 +610,7 @@ def _table(config, rounds, bootstrap):
                      config["seed"])
 
 
-def format_table(results):
+def format_standings(results):
     """The league table as fixed-width text; a bot's name (a submission's file name) shown
     escaped (``seats.printable``), then cut to its last 28 characters."""
     lines = [f"{'bot':<28}{'played':>7}{'W-D-L':>12}{'faults':>8}{'mu':>8}{'sigma':>7}"

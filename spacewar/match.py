@@ -20,37 +20,16 @@ from . import core
 from .game import Game
 from .protocol import raw_length
 from .rules import Rules, count_at_least
-from .seats import FAULT_KINDS, Limits, bot_name, open_seat, printable
+from .referee import Referee
+from .seats import Limits, bot_name, open_seat
 
 DEFAULT_BUDGET = 0.05  # seconds per action
 DEFAULT_MAX_FAULTS = 25
-MAX_MESSAGE = 300  # characters of a fault message kept in the result
 
 
 def bot_seed(seed, seat):
     """The seed a seat's bot gets: derived from the match seed, different per seat."""
     return int(np.random.SeedSequence([int(seed), 7919, seat]).generate_state(1)[0])
-
-
-class FaultLog:
-    """Counts of each kind of fault of one seat, the first few messages and the last one."""
-
-    def __init__(self):
-        self.counts = {kind: 0 for kind in FAULT_KINDS}
-        self.examples = []
-        self.last = None
-        self.total = 0
-
-    def add(self, frame, kind, message):
-        self.counts[kind] += 1
-        self.total += 1
-        self.last = {"frame": int(frame), "kind": kind,
-                     "message": printable(str(message))[:MAX_MESSAGE]}
-        if len(self.examples) < 5:
-            self.examples.append(self.last)
-
-    def to_dict(self):
-        return {"total": self.total, **self.counts, "examples": self.examples, "last": self.last}
 
 
 def play_match(p1, p2, seed=0, rounds=5, rules=None, budget=DEFAULT_BUDGET,
@@ -91,18 +70,15 @@ def play_match(p1, p2, seed=0, rounds=5, rules=None, budget=DEFAULT_BUDGET,
       time, in the order asked).
     """
     for field, bot in (("p1", p1), ("p2", p2)):
-        _check_bot_argument(field, bot)
+        check_bot_argument(field, bot)
     rules = Rules() if rules is None else rules
     count_at_least("seed", seed, 0)
     limits = checked_limits(max_faults, budget, limits)
     game = Game(rules, seeds=[seed], rounds=rounds)
-    cpu = _cpu_seconds(rules, rounds, limits)
+    cpu = cpu_seconds(rules, rounds, limits)
     seats = []
-    faults = [FaultLog(), FaultLog()]
-    forfeits = [False, False]
+    referee = Referee(max_faults, record)
     outputs = [None, None]
-    history = bytearray() if record else None
-    fault_codes = bytearray() if record else None
     start = time.perf_counter()
     try:
         for s, spec in enumerate((p1, p2)):
@@ -110,35 +86,18 @@ def play_match(p1, p2, seed=0, rounds=5, rules=None, budget=DEFAULT_BUDGET,
                                    rounds=rounds))
         for s, seat in enumerate(seats):
             if hasattr(seat, "wait_ready") and seat.wait_ready() is not None:
-                faults[s].add(0, *seat.dead)
-                forfeits[s] = True
+                referee.could_not_start(s, seat.dead)
         ready = time.perf_counter()
         actions = np.full((1, 2), core.NOOP, dtype=np.int64)
         raws = np.empty((2, raw_length(rules)))  # every seat copies what it keeps
         for s in range(2):
-            game._write_raw(0, s, raws[s])
-        match_state = game.match_state[0]  # this loop's Python is most of a frame's cost
-        over, frame_index = core.OVER, core.FRAME
-        forfeited = any(forfeits)
-        while not match_state[over] and not forfeited:
-            kinds = [0, 0]
-            for s, seat in enumerate(seats):
-                code, fault = seat.act(raws[s])
-                actions[0, s] = code
-                if fault is not None:
-                    faults[s].add(int(match_state[frame_index]), *fault)
-                    kinds[s] = 1 + FAULT_KINDS.index(fault[0])
-                if seat.dead is not None or faults[s].total >= max_faults:
-                    forfeits[s] = forfeited = True
-            if record:
-                fault_codes += bytes(kinds)
-            if forfeited:
+            game.write_raw(0, s, raws[s])
+        match_state = game.match_state[0]
+        # codes from protocol.action_code, already checked; the frame, then what each seat
+        # sees next, in one compiled call (spacewar.referee)
+        while not match_state[core.OVER] and not referee.forfeited:
+            if not referee.play_frame(game, seats, raws, actions):
                 break
-            # codes from protocol.action_code, already checked; the frame, then what each
-            # seat sees next, in one compiled call
-            game._step_one_codes(0, actions, raws)
-            if record:
-                history += bytes((int(actions[0, 0]), int(actions[0, 1])))
             if on_frame is not None:
                 on_frame(game)
     finally:
@@ -146,7 +105,8 @@ def play_match(p1, p2, seed=0, rounds=5, rules=None, budget=DEFAULT_BUDGET,
             outputs[s] = seat.close()
     end = time.perf_counter()
     wall = end - start
-    result = _result(game, (bot_name(p1), bot_name(p2)), seed, rounds, rules, faults, forfeits, outputs)
+    result = match_result(game, (bot_name(p1), bot_name(p2)), seed, rounds, rules,
+                          referee.faults, referee.forfeits, outputs)
     playing = end - ready
     result_timing = {"wall_seconds": wall, "frames_per_second": result["steps"] / max(wall, 1e-9),
                      "startup_seconds": ready - start, "play_seconds": playing,
@@ -158,12 +118,13 @@ def play_match(p1, p2, seed=0, rounds=5, rules=None, budget=DEFAULT_BUDGET,
     if record:
         from .replay import make_replay
 
-        return result, make_replay(result, bytes(history), game.state_hash(0),
-                                   faults=bytes(fault_codes), max_faults=max_faults), result_timing
+        replay = make_replay(result, bytes(referee.history), game.state_hash(0),
+                             faults=bytes(referee.fault_codes), max_faults=max_faults)
+        return result, replay, result_timing
     return result, None, result_timing
 
 
-def _check_bot_argument(field, bot):
+def check_bot_argument(field, bot):
     """A bot argument of ``play_match`` that can never play is a TypeError naming it."""
     if isinstance(bot, str):
         return
@@ -198,7 +159,7 @@ def checked_limits(max_faults, budget, limits):
     return limits
 
 
-def _cpu_seconds(rules, rounds, limits):
+def cpu_seconds(rules, rounds, limits):
     """CPU seconds a bot's process may use: its start-up and every frame at full budget."""
     frames = (rounds + rules.max_extra_rounds) * (rules.max_round_frames + rules.post_round_delay)
     if limits.cpu_seconds is not None:
@@ -206,7 +167,7 @@ def _cpu_seconds(rules, rounds, limits):
     return int(math.ceil(limits.startup + limits.overage + frames * limits.budget)) + 5
 
 
-def _result(game, bots, seed, rounds, rules, faults, forfeits, outputs, m=0):
+def match_result(game, bots, seed, rounds, rules, faults, forfeits, outputs, m=0):
     """Match ``m``'s plain-data result (see the module's text)."""
     score = [int(x) for x in game.scores[m]]
     forfeit = forfeits.index(True) if forfeits.count(True) == 1 else None

@@ -32,15 +32,15 @@ from engine.atomic import check_output_path
 from . import core
 from . import keys as K
 from .game import Game
-from .match import DEFAULT_MAX_FAULTS, FaultLog, _cpu_seconds, bot_seed, checked_limits
-from .match import _result as match_result
+from .faults import FAULT_KINDS, printable
+from .match import DEFAULT_MAX_FAULTS, bot_seed, checked_limits, cpu_seconds, match_result
 from .protocol import Action, raw_length
+from .referee import Referee
 from .render import DIM_TEXT, TEXT, Effects, frame_snapshot, scene
 from .rules import Rules
-from .seats import FAULT_KINDS, bot_name, open_seat, printable
+from .seats import bot_name, open_seat
 from .viewer import (WATCH_SCREEN_HELP, Pace, Window, blend, check_display, check_speed,
                      check_window_arguments, help_lines, run_window)
-from .viewer import paint as _paint  # noqa: F401  (the name the Gymnasium env's window uses)
 from .viewer import require_pygame
 
 BOT_BUDGET = 0.05  # seconds per bot action
@@ -62,14 +62,14 @@ KEY_NAMES = K.PLAY_KEY_NAMES
 KEYS_HELP = K.SOLO.help() + K.PLAY_CONTROLS_HELP
 
 
-def action_code(held, keyset=K.SOLO):
+def held_keys_code(held, keyset=K.SOLO):
     """The action code for the set of held key names under ``keyset`` (default: one person's
     keys); pressing both turn keys is hyperspace."""
     turn, thrust, fire, hyperspace, flip = keyset.action(held)
     return Action(turn=turn, thrust=thrust, fire=fire, hyperspace=hyperspace, flip=flip).code()
 
 
-def script_source(script):
+def play_script_source(script):
     """``keys.script_source`` for the keys ``play`` reads: a function ``tick -> held keys``
     from a callable or a sequence of ``(tick, keys)``; ticks count the window's fixed-rate
     ticks from the start, paused or not."""
@@ -94,7 +94,7 @@ class KeyboardSeat:
         return None
 
     def act(self, raw):
-        return action_code(self.held, self.keyset), None
+        return held_keys_code(self.held, self.keyset), None
 
     def close(self):
         return {"text": "", "bytes": 0, "truncated": False}
@@ -129,7 +129,7 @@ def _open_seats(specs, names, seed, limits, rules, rounds, isolation):
     """The two seats, bots started and ready; a bot that cannot start is a ValueError
     naming it (nothing is left running)."""
     keysets = _keysets(specs)
-    cpu = _cpu_seconds(rules, rounds, limits)  # a confined bot's CPU time, as in a match
+    cpu = cpu_seconds(rules, rounds, limits)  # a confined bot's CPU time, as in a match
     seats = []
     try:
         for s, spec in enumerate(specs):
@@ -164,10 +164,9 @@ class LiveMatch:
         self.seed = seed
         self.rounds = rounds
         self.max_faults = max_faults
-        self.faults = [FaultLog(), FaultLog()]
-        self.forfeits = [False, False]
-        self.history = bytearray()
-        self.fault_codes = bytearray()
+        self.referee = Referee(max_faults, record=True)
+        self.faults = self.referee.faults
+        self.forfeits = self.referee.forfeits
         self.fired = [0, 0]
         self.distance = [0.0, 0.0]
         self.jumps = [0, 0]
@@ -177,7 +176,7 @@ class LiveMatch:
         self._actions = np.full((1, 2), 0, dtype=np.int64)
         self._raws = np.empty((2, raw_length(game.rules)))
         for s in range(2):
-            game._write_raw(0, s, self._raws[s])
+            game.write_raw(0, s, self._raws[s])
 
     @property
     def over(self):
@@ -197,23 +196,11 @@ class LiveMatch:
     def play_frame(self):
         """Ask both seats, then step the game one frame (unless a seat forfeited)."""
         game = self.game
-        frame = int(game.match_state[0, core.FRAME])
-        kinds = [0, 0]
-        for s, seat in enumerate(self.seats):
-            code, fault = seat.act(self._raws[s])
-            self._actions[0, s] = code
-            if fault is not None:
-                self.faults[s].add(frame, *fault)
-                kinds[s] = 1 + FAULT_KINDS.index(fault[0])
-            if seat.dead is not None or self.faults[s].total >= self.max_faults:
-                self.forfeits[s] = True
-        self.fault_codes += bytes(kinds)
-        if any(self.forfeits):
-            return
         before = self._counters()
-        self.previous_positions = (game.pos[0].copy(), game.active[0].copy())
-        game._step_one_codes(0, self._actions, self._raws)
-        self.history += bytes((int(self._actions[0, 0]), int(self._actions[0, 1])))
+        positions = (game.pos[0].copy(), game.active[0].copy())
+        if not self.referee.play_frame(game, self.seats, self._raws, self._actions):
+            return
+        self.previous_positions = positions
         self._count(before)
         self.effects.update(frame_snapshot(game))
 
@@ -245,8 +232,8 @@ class LiveMatch:
         outputs = [seat.close() for seat in self.seats]
         result = match_result(self.game, self.names, self.seed, self.rounds, rules, self.faults,
                               self.forfeits, outputs)
-        replay = make_replay(result, bytes(self.history), self.game.state_hash(0),
-                             faults=bytes(self.fault_codes), max_faults=self.max_faults)
+        replay = make_replay(result, bytes(self.referee.history), self.game.state_hash(0),
+                             faults=bytes(self.referee.fault_codes), max_faults=self.max_faults)
         return result, replay
 
 
@@ -570,5 +557,5 @@ def _fault_cell(faults):
     return f"{faults['total']} ({kinds})"
 
 
-__all__ = ["play", "watch", "format_summary", "action_code", "script_source", "KeyboardSeat",
+__all__ = ["play", "watch", "format_summary", "held_keys_code", "play_script_source", "KeyboardSeat",
            "LiveMatch", "LiveSession", "KEYS_HELP", "KEY_NAMES", "require_pygame"]

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import codes as core
+from . import codes
 
 
 @dataclass(frozen=True)
@@ -43,8 +43,8 @@ class Action:
     @classmethod
     def from_code(cls, code):
         code = int(code)
-        if not 0 <= code < core.N_ACTIONS:
-            raise ValueError(f"action code must be in [0, {core.N_ACTIONS}), got {code!r}")
+        if not 0 <= code < codes.N_ACTIONS:
+            raise ValueError(f"action code must be in [0, {codes.N_ACTIONS}), got {code!r}")
         return cls(turn=code % 3 - 1, thrust=bool((code // 3) % 2), fire=bool((code // 6) % 2),
                    hyperspace=bool((code // 12) % 2), flip=bool((code // 24) % 2))
 
@@ -72,7 +72,7 @@ def action_code(action):
     else:
         turn, thrust, fire, hyperspace, flip = _looked_up_fields(action)
     if type(turn) not in _TURN_TYPES or turn not in (-1, 0, 1):
-        raise ValueError(f"turn must be -1, 0 or 1, got {_short_repr(turn)}")
+        raise ValueError(f"turn must be -1, 0 or 1, got {short_repr(turn)}")
     if type(thrust) not in _BOOL_TYPES:
         _not_a_bool("thrust", thrust)
     if type(fire) not in _BOOL_TYPES:
@@ -97,14 +97,14 @@ def _looked_up_fields(action):
 
 
 def _not_a_bool(name, value):
-    raise ValueError(f"{name} must be True or False, got {_short_repr(value)}")
+    raise ValueError(f"{name} must be True or False, got {short_repr(value)}")
 
 
 # exact types only: a subclass of int could answer anything to ``in`` and ``int()``
 _TURN_TYPES = (int, float, np.int8, np.int16, np.int32, np.int64, np.float32, np.float64)
 
 
-def _short_repr(value):
+def short_repr(value):
     """A repr that cannot raise and is at most 80 characters."""
     try:
         text = repr(value)

@@ -37,14 +37,15 @@ from engine.atomic import atomic_write, check_output_path
 from . import core
 from .game import Game
 from .rules import Rules
-from .seats import FAULT_KINDS
+from .faults import FAULT_KINDS
+from .referee import Referee
 from .strangers_files import FileRefused, read_bounded
 
 FORMAT = "spacewar-replay"
 VERSION = 2
 READABLE_VERSIONS = (1, 2)
 DIGEST_FIELD = "content_sha256"
-# fault kinds in code order (spacewar.seats.FAULT_KINDS): code k (1..6) is FAULT_KINDS[k - 1];
+# fault kinds in code order (spacewar.faults.FAULT_KINDS): code k (1..6) is FAULT_KINDS[k - 1];
 # 0 means no fault
 MAX_FILE_BYTES = 64 * 1024 * 1024
 MAX_SEED = 2 ** 64 - 1
@@ -602,25 +603,15 @@ def _replay_match(replay):
     limit = math.inf if replay.get("max_faults") is None else replay["max_faults"]
     startup = replay.get("startup") or [0, 0]
     fatal = replay.get("fatal") or [None, None]
-    counts = [{kind: 0 for kind in FAULT_KINDS} for _ in range(2)]
-    examples = [[], []]
-    last = [None, None]
-    forfeits = [False, False]
-
-    def add(s, frame, code):
-        kind = FAULT_KINDS[code - 1]
-        counts[s][kind] += 1
-        last[s] = {"frame": int(frame), "kind": kind}
-        if len(examples[s]) < 5:
-            examples[s].append(last[s])
-
+    # the match's own referee, judging the recorded faults again (their messages are not
+    # recorded: the logs are compared without them)
+    referee = Referee(limit)
     for s in range(2):
         if startup[s]:
-            add(s, 0, startup[s])
-            forfeits[s] = True
+            referee.could_not_start(s, (FAULT_KINDS[startup[s] - 1], ""))
     played = 0
     asked = 0
-    if not any(forfeits):
+    if not referee.forfeited:
         for i in range(rows.shape[0]):
             if game.over[0]:
                 break
@@ -632,13 +623,11 @@ def _replay_match(replay):
                     problems.append(f"seat {s} has a fault at frame {i} but its recorded action "
                                     f"is {int(codes[i, s])}, not the no-op a fault plays")
                 if code:
-                    add(s, frame, code)
+                    referee.judge(s, frame, (FAULT_KINDS[code - 1], ""), dead=fatal[s] == i)
                 elif fatal[s] == i:
                     problems.append(f"seat {s} is marked as ended by a fault at frame {i}, "
                                     "where it has none")
-                if code and (sum(counts[s].values()) >= limit or fatal[s] == i):
-                    forfeits[s] = True
-            if any(forfeits):
+            if referee.questions_done():
                 break
             if i >= codes.shape[0]:
                 problems.append(f"frame {i} has a fault record but no actions")
@@ -651,6 +640,7 @@ def _replay_match(replay):
     if asked < rows.shape[0]:
         problems.append(f"fault record continues past the end of the match: "
                         f"{rows.shape[0] - asked} frame(s) after it ended")
+    forfeits = referee.forfeits
     for s in range(2):
         if fatal[s] is not None and not forfeits[s]:
             problems.append(f"seat {s} is marked as ended by a fault at frame {fatal[s]}, "
@@ -658,7 +648,8 @@ def _replay_match(replay):
     if not any(forfeits) and not game.over[0]:
         problems.append(f"the record stops at frame {played} before the match is over and "
                         "nobody forfeited")
-    logs = [(counts[s], examples[s], last[s]) for s in range(2)]
+    logs = [(log.counts, [_without_message(e) for e in log.examples],
+             _without_message(log.last)) for log in referee.faults]
     return game, forfeits, logs, problems
 
 

@@ -43,12 +43,12 @@ import time
 import numpy as np
 
 from . import codes, confinement, wire
+from .ask import ask
 from .batch_bots import is_batch_bot, one_match_bot
 from .bots import BotLoadError, absolute_spec, is_builtin, locate, make_bot
+from .faults import FAULT_KINDS, KIND_BY_STATUS, printable  # noqa: F401 (FAULT_KINDS: public here too)
 from .protocol import observation_of_copy
 
-FAULT_KINDS = ("raised", "invalid", "timeout", "crashed", "startup", "memory")
-_KIND_BY_STATUS = {wire.RAISED: "raised", wire.INVALID: "invalid", wire.MEMORY: "memory"}
 SHOWN_OUTPUT = 4096  # bytes of a bot's stdout and stderr kept in the result
 
 
@@ -100,7 +100,7 @@ class Limits:
                              f"got {self.cpu_seconds!r}")
 
 
-class _Bank:
+class TimeBank:
     """The overage bank: time over the budget is paid from it while it lasts."""
 
     def __init__(self, limits):
@@ -138,7 +138,7 @@ class InlineSeat:
         self.act_seconds = array.array("d")  # each action's time (see the module's text)
         self._rules = type(rules).from_dict(rules.to_dict())  # decodes; the bot never sees it
         self.rules = type(rules).from_dict(rules.to_dict())  # the bot may break only its own copy
-        self.bank = _Bank(limits)
+        self.bank = TimeBank(limits)
         self.dead = None
         self.layers = ["in this process (built-in bot or the caller's bot object)"]
         try:
@@ -164,11 +164,11 @@ class InlineSeat:
         (a float64 array of ``raw_length``); the bot gets its own copy."""
         obs = observation_of_copy(raw.copy(), self._rules, self.rules)
         start = time.perf_counter()
-        status, code, text = wire.ask(self.bot, obs)
+        status, code, text = ask(self.bot, obs)
         elapsed = time.perf_counter() - start
         self.act_seconds.append(elapsed)
         if status in (wire.RAISED, wire.MEMORY):  # no answer at all: its time is not charged
-            return codes.NOOP, (_KIND_BY_STATUS[status], text)
+            return codes.NOOP, (KIND_BY_STATUS[status], text)
         if not self.bank.charge(elapsed):
             return codes.NOOP, ("timeout", self.bank.late(elapsed))
         if status == wire.INVALID:
@@ -177,12 +177,6 @@ class InlineSeat:
 
     def close(self):
         return {"text": "", "bytes": 0, "truncated": False}
-
-
-def printable(text):
-    """``text`` with every control character (terminal escapes, newlines) shown escaped, so a
-    bot's message cannot redraw the terminal it is printed on."""
-    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
 
 
 _PROJECT_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -216,7 +210,7 @@ class ProcessSeat:
         self.spec = spec
         self.act_seconds = array.array("d")  # each action's time (see the module's text)
         self.limits = limits
-        self.bank = _Bank(limits)
+        self.bank = TimeBank(limits)
         self.dead = None
         self.layers = []
         self._pending = None  # (frame, time sent) of the observation awaiting an answer
@@ -401,8 +395,8 @@ class ProcessSeat:
             if 0 <= code < codes.N_ACTIONS:
                 return code, None
             return codes.NOOP, ("invalid", f"action code {code} out of range [0, {codes.N_ACTIONS})")
-        if status in _KIND_BY_STATUS:
-            return codes.NOOP, (_KIND_BY_STATUS[status], text or wire.STATUS_NAMES[status])
+        if status in KIND_BY_STATUS:
+            return codes.NOOP, (KIND_BY_STATUS[status], text or wire.STATUS_NAMES[status])
         return codes.NOOP, self._stop("invalid", f"broke the protocol: status "
                                                  f"{wire.STATUS_NAMES[status]!r} during play")
 
@@ -623,7 +617,7 @@ class BatchProcessSeat(ProcessSeat):
                 return (wire.INVALID, None, f"action code {found[bad][0]} out of range "
                         f"[0, {codes.N_ACTIONS})", seconds, None)
             return wire.OK, found, "", seconds, None
-        if status in _KIND_BY_STATUS:
+        if status in KIND_BY_STATUS:
             return status, None, text or wire.STATUS_NAMES[status], seconds, None
         return None, None, "", None, self._stop(
             "invalid", f"broke the protocol: status {wire.STATUS_NAMES[status]!r} during play")

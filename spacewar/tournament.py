@@ -15,17 +15,18 @@ P(i beats j) = 1 / (1 + 10^((R_j - R_i) / 400)). Each bot also plays one virtual
 against a 1500-rated anchor, so a perfect record gives a finite rating (Hunter 2004, MM
 algorithm; the virtual draw is a standard prior).
 """
-import concurrent.futures
 import itertools
-import math
-import multiprocessing
 import os
 
 import numpy as np
 
-from .match import DEFAULT_BUDGET, DEFAULT_MAX_FAULTS, play_match
+from .faults import printable
+# the jobs' names, public here too (a tournament's work is cut by them)
+from .jobs import batch_files_of, group_jobs, make_jobs, match_record, warm_up_game  # noqa: F401
+from .match import DEFAULT_BUDGET, DEFAULT_MAX_FAULTS
 from .rules import Rules
-from .seats import Limits, printable
+from .runner import MatchRunner, progress_bar
+from .seats import Limits
 
 
 def schedule(bots, games, seed):
@@ -37,74 +38,6 @@ def schedule(bots, games, seed):
             out.append((bots[a], bots[b], match_seed))
             out.append((bots[b], bots[a], match_seed))
     return out
-
-
-def _play(job):
-    """A job's outcomes ``[(result, timing), ...]``: one match, or every match of a pairing
-    with a batch bot, played together (``spacewar.batch_match``)."""
-    matches, together, rounds, rules_dict, limits, max_faults, isolation, batch_files = job
-    rules = Rules.from_dict(rules_dict)
-    if together:
-        from .batch_match import play_matches
-
-        return play_matches(matches, rounds=rounds, rules=rules, limits=limits,
-                            max_faults=max_faults, batch_files=batch_files)
-    (p1, p2, match_seed), = matches
-    result, _, timing = play_match(p1, p2, seed=match_seed, rounds=rounds, rules=rules,
-                                   limits=limits, max_faults=max_faults, isolation=isolation)
-    return [(result, timing)]
-
-
-def batch_files_of(bots):
-    """The bots from files among ``bots`` that play as batch bots (their class defines
-    ``act_batch``: ``spacewar.bots.declares_act_batch``), read once for the whole run."""
-    from .bots import declares_act_batch
-
-    return frozenset(spec for spec in bots if declares_act_batch(spec))
-
-
-def group_jobs(schedule_, isolation, batch_files=frozenset()):
-    """The schedule cut into jobs ``(matches, together)``: each match alone, except that a
-    pairing with a batch bot (a policy file, or a bot from a file in ``batch_files``) and a
-    bot that can share its game (``batch_match.can_play_together``) is one job, all its
-    matches in one game, the batch bot answering for all of them at once (at most
-    ``wire.MAX_ROWS`` matches a job). Under ``isolation="process"`` every match plays alone."""
-    from .batch_match import can_play_together, is_batch_spec
-    from .wire import MAX_ROWS
-
-    jobs = []
-    for p1, p2, seed in schedule_:
-        together = (isolation != "process"
-                    and (is_batch_spec(p1, batch_files) or is_batch_spec(p2, batch_files))
-                    and can_play_together(p1, batch_files)
-                    and can_play_together(p2, batch_files))
-        if together and jobs and jobs[-1][0] and {p1, p2} == jobs[-1][2] \
-                and len(jobs[-1][1]) < MAX_ROWS // 2:
-            jobs[-1][1].append((p1, p2, seed))
-        else:
-            jobs.append((together, [(p1, p2, seed)], {p1, p2}))
-    return [(matches, together) for together, matches, _ in jobs]
-
-
-def _worker_start():
-    """A worker dies with the tournament's process (and its bots with it), instead of waiting
-    forever on a queue nobody feeds."""
-    from .confinement import die_with_parent
-
-    die_with_parent()
-
-
-def warm_up_game():
-    """A cluster worker's warm-up (``engine.cluster.WarmWorker``): the game's kernels."""
-    _warm_up(Rules())
-
-
-def _warm_up(rules):
-    """Compile (or load) the game's code here, once, before the workers start: workers then
-    only read numba's cache instead of all compiling and writing it at the same time."""
-    from .game import Game
-
-    Game(rules, seeds=[0], rounds=1).step()
 
 
 def bradley_terry_elo(names, results, iterations=2000):
@@ -165,77 +98,13 @@ def run_tournament(bots, games=10, seed=1, rounds=3, rules=None, workers=None, p
     limits = Limits(budget=budget) if limits is None else limits
     jobs = make_jobs(schedule(bots, games, seed), rounds, rules, limits, max_faults, isolation,
                      batch_files_of(bots))
-    bar = _progress(sum(len(job[0]) for job in jobs), progress)
+    bar = progress_bar(sum(len(job[0]) for job in jobs), progress)
     try:
         with MatchRunner(bots, rules, workers, scheduler) as runner:
             outcomes = runner.play(jobs, bar.update)
     finally:
         bar.close()
     return _report(bots, games, seed, rounds, rules, outcomes)
-
-
-def make_jobs(schedule_, rounds, rules, limits, max_faults, isolation, batch_files):
-    """The work of a schedule: ``group_jobs``' matches with everything a worker needs to
-    play them."""
-    return [(matches, together, rounds, rules.to_dict(), limits, max_faults, isolation,
-             batch_files)
-            for matches, together in group_jobs(schedule_, isolation, batch_files)]
-
-
-class MatchRunner:
-    """Where matches are played, kept open across calls (a league plays round after round):
-    in this process (``workers=1``), in a pool of ``workers`` local processes, or on the Dask
-    cluster at ``scheduler`` (an address, or ``"local"``; default: ``DASK_SCHEDULER_ADDRESS``,
-    else local). ``play(jobs, progress)`` gives every job's outcomes in job order whichever it
-    is, so the results are the same."""
-
-    def __init__(self, bots, rules, workers, scheduler=None):
-        from engine.cluster import scheduler_address
-
-        self.address = scheduler_address(scheduler)
-        self.bots, self.rules, self.workers = list(bots), rules, workers
-        self._pool = self._connection = None
-
-    def play(self, jobs, progress=lambda matches: None):
-        if self.address is not None:
-            return self._play_on_cluster(jobs, progress)
-        if self.workers == 1:
-            outcomes = []
-            for job in jobs:
-                outcomes.extend(_play(job))
-                progress(len(job[0]))
-            return outcomes
-        if self._pool is None:
-            _warm_up(self.rules)
-            ctx = multiprocessing.get_context("spawn")
-            self._pool = concurrent.futures.ProcessPoolExecutor(
-                max_workers=self.workers, mp_context=ctx, initializer=_worker_start)
-        futures = {self._pool.submit(_play, job): len(job[0]) for job in jobs}
-        for future in concurrent.futures.as_completed(futures):
-            future.result()  # surface worker errors early
-            progress(futures[future])
-        return [outcome for f in futures for outcome in f.result()]
-
-    def _play_on_cluster(self, jobs, progress):
-        from . import cluster_play
-
-        if self._connection is None:
-            self._connection = cluster_play.connect(self.address, self.bots)
-        return cluster_play.play_jobs(self._connection, jobs, progress)
-
-    def close(self):
-        if self._pool is not None:
-            self._pool.shutdown(cancel_futures=True)
-            self._pool = None
-        if self._connection is not None:
-            self._connection.close()
-            self._connection = None
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
 
 
 def _report(bots, games, seed, rounds, rules, outcomes):
@@ -248,15 +117,6 @@ def _report(bots, games, seed, rounds, rules, outcomes):
         "rules": rules.to_dict(), "table": table,
         "matches": [match_record(r) for r in matches],
     }, {"frames": frames, "match_seconds": wall}
-
-
-def match_record(result):
-    """A match's line in a tournament's or a league's results: a match result cut to plain
-    data (fault totals, no wall-clock figure)."""
-    return {"p1": result["bots"][0], "p2": result["bots"][1], "seed": result["seed"],
-            "winner": result["winner"], "score": result["score"], "steps": result["steps"],
-            "forfeit": result["forfeit"], "forfeits": result["forfeits"],
-            "faults": [result["faults"][0]["total"], result["faults"][1]["total"]]}
 
 
 def _table(bots, matches):
@@ -284,24 +144,6 @@ def _table(bots, matches):
     for b in bots:
         rows[b]["elo"] = round(elo[b], 1)
     return sorted(rows.values(), key=lambda row: (-row["elo"], row["bot"]))
-
-
-class _NoBar:
-    def update(self, n):
-        pass
-
-    def close(self):
-        pass
-
-
-def _progress(total, enabled, what="tournament"):
-    if not enabled:
-        return _NoBar()
-    try:
-        from tqdm import tqdm
-    except ImportError:
-        return _NoBar()
-    return tqdm(total=total, unit="match", desc=what, leave=False)
 
 
 def format_table(report):

@@ -56,9 +56,9 @@ try:
 except ImportError as error:  # pragma: no cover - the extra is missing
     raise ImportError("spacewar.train needs JAX and optax: pip install -e '.[rl]'") from error
 
-from .learning import learning_layout, learning_length
-from .policy import (ACTION_FORMAT, ACTIVATIONS, FORMAT_VERSION, NVEC, Policy,
-                     check_policy_path, default_inputs, layout_sha256, save_policy)
+from .features import learning_layout, learning_length
+from .bots.policy import (ACTION_FORMAT, ACTIVATIONS, FORMAT_VERSION, NVEC, Policy,
+                          check_policy_path, default_inputs, layout_sha256, save_policy)
 from .rules import Rules
 
 _SLICES = tuple((int(a), int(b)) for a, b in zip(np.cumsum((0,) + NVEC)[:-1], np.cumsum(NVEC)))

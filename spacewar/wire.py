@@ -10,7 +10,7 @@ match -> bot
   START   ``SWS1`` u32 length, then that many bytes of UTF-8 JSON (the bot's configuration)
   OBSERVE ``SWO1`` i64 frame, u32 count, then count float64 (``spacewar.protocol.raw_layout``)
   BATCH   ``SWB1`` i64 call, u32 rows, u32 width, then rows x width float32 (a batch bot's
-          learning observations, ``spacewar.learning.learning_layout``, one row per match)
+          learning observations, ``spacewar.features.learning_layout``, one row per match)
   STOP    ``SWQ1`` i64 0, u32 0
 
 bot -> match
@@ -32,7 +32,6 @@ import struct
 
 import numpy as np
 
-from .protocol import _short_repr, action_code
 
 START_MAGIC, OBSERVE_MAGIC, STOP_MAGIC, ANSWER_MAGIC = b"SWS1", b"SWO1", b"SWQ1", b"SWA1"
 BATCH_MAGIC, CODES_MAGIC = b"SWB1", b"SWC1"
@@ -124,34 +123,6 @@ def exception_text(exc):
     except BaseException:
         text = f"{type(exc).__name__} (its message could not be shown)"
     return text[:MAX_TEXT]
-
-
-def ask(bot, obs):
-    """Ask ``bot`` for its action on ``obs``: ``(status, code, text)``, whatever it does.
-
-    Used on both sides of the wire: by a bot's process (``spacewar.bothost``) and by the
-    match for a bot it calls directly (``spacewar.seats.InlineSeat``). The code comes from the
-    answer's fields (``spacewar.protocol.action_code``), never from what its class says.
-    """
-    if type(bot) is _SINGLE_FROM_BATCH[0]:  # a batch bot playing one match: K = 1
-        return bot.answer(obs)
-    try:
-        result = bot.act(obs)
-    except MemoryError:
-        return MEMORY, 0, "MemoryError in act"
-    except BaseException as exc:  # SystemExit and KeyboardInterrupt from a bot are its faults
-        return RAISED, 0, exception_text(exc)
-    try:
-        return OK, action_code(result), ""
-    except ValueError as exc:
-        return INVALID, 0, f"returned {_short_repr(result)}: {exc}"
-    except BaseException as exc:
-        return INVALID, 0, exception_text(exc)
-
-
-#: ``batch_bots.SingleFromBatch`` once that module is imported (it imports this one, and sets
-#: it); until then no bot can be one, and the placeholder is a class no bot is an instance of
-_SINGLE_FROM_BATCH = [type("_NoSingleFromBatchYet", (), {})]
 
 
 def pack_answer(frame, status, code=0, text=""):

@@ -30,14 +30,10 @@ import stat
 import sys
 import tokenize
 
-#: name -> "module:Class" of the built-in bots
-BUILTIN = {
-    "idle": "spacewar.bots.idle:Idle",
-    "random": "spacewar.bots.random_bot:RandomBot",
-    "chaser": "spacewar.bots.chaser:Chaser",
-    "sniper": "spacewar.bots.sniper:Sniper",
-    "dodger": "spacewar.bots.dodger:Dodger",
-}
+from ..builtin_bots import BUILTIN_BOTS
+
+#: name -> "module:Class" of the built-in bots (``spacewar.builtin_bots``, the one list)
+BUILTIN = {name: f"{module}:{cls}" for name, module, cls in BUILTIN_BOTS}
 
 
 class BotLoadError(ValueError):
@@ -74,7 +70,7 @@ def is_builtin(spec):
     return isinstance(spec, str) and (spec in BUILTIN or is_policy_file(spec))
 
 
-def _split(spec):
+def split_spec(spec):
     if not isinstance(spec, str) or not spec:
         raise BotLoadError(f"bot must be a name or 'module:Class' string, got {spec!r}")
     target = BUILTIN.get(spec, spec)
@@ -87,7 +83,7 @@ def _split(spec):
     return where, class_name
 
 
-def _is_file_spec(where):
+def is_file_spec(where):
     return where.endswith(".py") or os.sep in where or "/" in where
 
 
@@ -107,10 +103,10 @@ def locate(spec):
         if not os.path.isfile(path):
             raise BotLoadError(f"policy file {spec!r} does not exist")
         return [path], [], None
-    where, _ = _split(spec)
+    where, _ = split_spec(spec)
     if is_builtin(spec):
         return [], [], None
-    if _is_file_spec(where):
+    if is_file_spec(where):
         path = os.path.abspath(where)
         if not os.path.isfile(path):
             raise BotLoadError(f"bot file {where!r} does not exist")
@@ -158,8 +154,8 @@ def import_top_level(spec, directory):
     portions, looked up on ``sys.path``, stay found). Raises
     ``BotLoadError`` when the import fails, or when a module of that name is already loaded
     from elsewhere (one the bot's host itself uses)."""
-    where, _ = _split(spec)
-    if is_builtin(spec) or _is_file_spec(where):
+    where, _ = split_spec(spec)
+    if is_builtin(spec) or is_file_spec(where):
         return None
     top = where.split(".")[0]
     module = sys.modules.get(top)
@@ -221,8 +217,8 @@ def declares_act_batch(spec):
     if not isinstance(spec, str) or is_builtin(spec):
         return False
     try:
-        where, class_name = _split(spec)
-        path = os.path.abspath(where) if _is_file_spec(where) else _module_source(where)
+        where, class_name = split_spec(spec)
+        path = os.path.abspath(where) if is_file_spec(where) else _module_source(where)
     except (BotLoadError, OSError, ImportError, ValueError):
         return False
     if path is None or not path.endswith(".py"):
@@ -392,10 +388,10 @@ def bot_identity(spec):
     if is_policy_file(spec):
         path, class_name = spec, None
     else:
-        where, class_name = _split(spec)
+        where, class_name = split_spec(spec)
         target = BUILTIN.get(spec, spec)
         try:
-            path = where if _is_file_spec(where) else _module_source(target.rsplit(":", 1)[0])
+            path = where if is_file_spec(where) else _module_source(target.rsplit(":", 1)[0])
         except (ImportError, ValueError):
             path = None
         if path is None:
@@ -413,8 +409,8 @@ def absolute_spec(spec):
     """``spec`` with a bot file's path made absolute (a bot's process starts elsewhere)."""
     if is_policy_file(spec):
         return os.path.abspath(spec)
-    where, class_name = _split(spec)
-    if not is_builtin(spec) and _is_file_spec(where):
+    where, class_name = split_spec(spec)
+    if not is_builtin(spec) and is_file_spec(where):
         return f"{os.path.abspath(where)}:{class_name}"
     return spec
 
@@ -440,8 +436,8 @@ def _import_from_file(path, class_name):
 
 def load_bot_class(spec):
     """The bot class named by ``spec`` (a built-in name, ``module:Class`` or ``file.py:Class``)."""
-    where, class_name = _split(spec)
-    if _is_file_spec(where):
+    where, class_name = split_spec(spec)
+    if is_file_spec(where):
         cls, origin = _import_from_file(where, class_name)
     else:
         try:
@@ -462,7 +458,7 @@ def load_bot_class(spec):
 def make_bot(spec, seed=None):
     """An instance of the bot ``spec``, given ``seed`` if its constructor takes one."""
     if is_policy_file(spec):
-        from ..policy import PolicyBot, PolicyError
+        from .policy import PolicyBot, PolicyError
 
         try:
             return PolicyBot(spec, seed=seed)

@@ -27,7 +27,7 @@ def distributed(optional):
 
 @pytest.fixture(scope="module")
 def dask_cluster(distributed):
-    cluster.warm_up(["spacewar.tournament:warm_up_game"])  # the workers then only load
+    cluster.warm_up(["spacewar.jobs:warm_up_game"])  # the workers then only load
     with distributed.LocalCluster(n_workers=2, processes=True, threads_per_worker=1,
                                   dashboard_address=":0") as local:
         yield local

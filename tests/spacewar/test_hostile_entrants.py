@@ -60,7 +60,7 @@ def worker_tmp(tmp_path_factory):
 @pytest.fixture(scope="module")
 def dask_cluster(worker_tmp, optional):
     distributed = optional("distributed")
-    cluster.warm_up(["spacewar.tournament:warm_up_game"])  # the workers then only load
+    cluster.warm_up(["spacewar.jobs:warm_up_game"])  # the workers then only load
     saved = os.environ.get("TMPDIR")
     os.environ["TMPDIR"] = str(worker_tmp)  # the workers' tempfile.gettempdir()
     try:

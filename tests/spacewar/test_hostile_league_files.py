@@ -158,11 +158,11 @@ def test_a_flipped_winner_and_score_is_refused_as_forged_and_resumes_only_when_t
     assert results["resumed_from"] == [{"signature": "forged", "rounds": ROUNDS}]
     assert _row(results, new_winner)["wins"] == _row(honest, new_winner)["wins"] + 1
     assert ("NOTE: resumed with --trust-results from a forged (signature not matching) results "
-            "file: its first 2 rounds are not verified") in league.format_table(results)
+            "file: its first 2 rounds are not verified") in league.format_standings(results)
     # the file is now this user's, and keeps its mark when it is resumed again
     again = league.run_league(BOTS, ROUNDS + 1, path, **QUICK)
     assert again["resumed_from"] == [{"signature": "forged", "rounds": ROUNDS}]
-    assert "NOTE: resumed with --trust-results" in league.format_table(again)
+    assert "NOTE: resumed with --trust-results" in league.format_standings(again)
 
 
 def test_a_bad_signature_is_refused_as_forged(tmp_path, legit):

@@ -21,7 +21,7 @@ from spacewar import play as play_module  # noqa: E402
 from spacewar import replay as replay_io  # noqa: E402
 from spacewar import viewer  # noqa: E402
 from spacewar.match import play_match  # noqa: E402
-from spacewar.play import action_code, format_summary, play, script_source, watch  # noqa: E402
+from spacewar.play import format_summary, held_keys_code, play, play_script_source, watch  # noqa: E402
 from spacewar.protocol import Action  # noqa: E402
 from spacewar.rules import Rules  # noqa: E402
 from spacewar.seats import Limits  # noqa: E402
@@ -93,26 +93,26 @@ def compiled_frames():
 
 
 def test_keys_to_actions():
-    assert action_code(frozenset()) == Action().code()
-    assert action_code(frozenset({"a"})) == Action(turn=1).code()
-    assert action_code(frozenset({"right"})) == Action(turn=-1).code()
-    assert action_code(frozenset({"up", "space"})) == Action(thrust=True, fire=True).code()
-    assert action_code(frozenset({"w", "s", "f"})) == Action(thrust=True, fire=True, flip=True).code()
+    assert held_keys_code(frozenset()) == Action().code()
+    assert held_keys_code(frozenset({"a"})) == Action(turn=1).code()
+    assert held_keys_code(frozenset({"right"})) == Action(turn=-1).code()
+    assert held_keys_code(frozenset({"up", "space"})) == Action(thrust=True, fire=True).code()
+    assert held_keys_code(frozenset({"w", "s", "f"})) == Action(thrust=True, fire=True, flip=True).code()
     # both turn keys at once is hyperspace, as on the 1962 control boxes
-    assert action_code(frozenset({"a", "d"})) == Action(hyperspace=True).code()
-    assert action_code(frozenset({"h"})) == Action(hyperspace=True).code()
+    assert held_keys_code(frozenset({"a", "d"})) == Action(hyperspace=True).code()
+    assert held_keys_code(frozenset({"h"})) == Action(hyperspace=True).code()
 
 
 def test_scripts():
-    held = script_source([(10, {"W"}), (0, set()), (20, ["space", "a"])])
+    held = play_script_source([(10, {"W"}), (0, set()), (20, ["space", "a"])])
     assert held(0) == frozenset() and held(9) == frozenset()
     assert held(10) == {"w"} and held(19) == {"w"}
     assert held(500) == {"space", "a"}
-    assert script_source(lambda f: "escape")(3) == {"escape"}
+    assert play_script_source(lambda f: "escape")(3) == {"escape"}
     with pytest.raises(ValueError, match="unknown key"):
-        script_source([(0, {"x"})])
+        play_script_source([(0, {"x"})])
     with pytest.raises(ValueError):
-        script_source(42)
+        play_script_source(42)
 
 
 THRUST_AND_FIRE = [(0, {"w"}), (20, {"w", "space"}), (70, {"a"}), (80, set())]
@@ -315,9 +315,9 @@ def test_a_match_left_before_its_end_writes_no_replay(pygame, tmp_path):
     (K.PLAYER_2, "w", Action()), (K.SOLO, "h", Action(hyperspace=True)),
 ])
 def test_each_key_set(keyset, key, action):
-    assert action_code(frozenset({key}), keyset) == action.code()
+    assert held_keys_code(frozenset({key}), keyset) == action.code()
     both_turns = keyset.left | keyset.right
-    assert action_code(frozenset(both_turns), keyset) == Action(hyperspace=True).code()
+    assert held_keys_code(frozenset(both_turns), keyset) == Action(hyperspace=True).code()
 
 
 def test_the_key_sets_do_not_share_a_key():

@@ -245,7 +245,7 @@ def test_the_loader_never_allows_pickle(monkeypatch, untrained):
         calls.append(kwargs.get("allow_pickle"))
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(policy_mod.np, "load", spy)
+    monkeypatch.setattr(np, "load", spy)
     Policy.load(untrained)
     assert calls == []  # the arrays are decoded from the checked bytes (np.frombuffer)
 

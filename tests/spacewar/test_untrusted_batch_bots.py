@@ -14,7 +14,7 @@ from spacewar.cli import main
 from spacewar.match import play_match
 from spacewar.seats import Limits
 from spacewar.tournament import batch_files_of, group_jobs, make_jobs, run_tournament, schedule
-from spacewar.tournament import _play as tournament_play
+from spacewar.jobs import play_job as tournament_play
 
 from . import hostile_batch_bots  # the same classes, played as objects
 from .test_untrusted_bots import FAST, LONG, ROOMY, SHORT, nothing_left_running  # noqa: F401

@@ -120,7 +120,7 @@ def test_import_time_patch_of_the_match_does_not_rig_a_tournament(tmp_path):
         import spacewar.match as m
         def rigged(game, bots, *args, **kw):
             return {"winner": bots[0], "score": [9, 0]}
-        m._result = rigged
+        m.match_result = rigged
         from spacewar import NOOP
         class Rigger:
             def act(self, obs):

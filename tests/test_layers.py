@@ -1,0 +1,153 @@
+"""The game's code keeps its one-way layers: every import of ``spacewar`` (inside functions
+too) points down the order declared once in pyproject.toml's ``[tool.importlinter]``; no
+module of ``spacewar`` or ``validation`` is in an import cycle or takes a private name from
+another; and the check is shown to catch each of these on a package made to break them."""
+import os
+import subprocess
+import sys
+import textwrap
+import tomllib
+
+import pytest
+
+from tests import import_graph
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def declared_layers(pyproject=os.path.join(ROOT, "pyproject.toml"), package="spacewar"):
+    """{module: layer number, 0 at the bottom} from the layers contract of ``package`` in
+    ``pyproject``'s import-linter configuration (listed top to bottom, ``a : b`` sharing one)."""
+    with open(pyproject, "rb") as f:
+        contracts = tomllib.load(f)["tool"]["importlinter"]["contracts"]
+    (layers,) = [c["layers"] for c in contracts
+                 if c["type"] == "layers" and c["layers"][0].startswith(package + ".")]
+    table = {}
+    for depth, line in enumerate(reversed(layers)):
+        for name in line.replace("|", ":").split(":"):
+            table[name.strip()] = depth
+    return table
+
+
+def layer_violations(root, package, layers):
+    """What the walk finds against the three rules: upward edges, cycles, private imports,
+    and modules the table does not place."""
+    found = import_graph.edges(root, package)
+    unplaced = [m for m in import_graph.modules(root, package)
+                if m != package and not _placed(m, layers)]
+    placed = [e for e in found if _placed(e.source, layers) and _placed(e.target, layers)]
+    return {"upward": import_graph.upward(placed, layers), "cycles": import_graph.cycles(found),
+            "private": import_graph.private_imports(found), "unplaced": unplaced}
+
+
+def _placed(module, layers):
+    try:
+        import_graph.layer_of(module, layers)
+        return True
+    except KeyError:
+        return False
+
+
+def test_every_spacewar_import_points_down_and_none_is_private_or_circular():
+    layers = declared_layers()
+    problems = layer_violations(ROOT, "spacewar", layers)
+    assert problems == {"upward": [], "cycles": [], "private": [], "unplaced": []}
+
+
+def test_validation_has_no_cycle_and_takes_no_private_name():
+    found = import_graph.edges(ROOT, "validation")
+    assert import_graph.cycles(found) == []
+    assert import_graph.private_imports(found) == []
+
+
+def test_the_import_linter_contracts_hold():
+    out = subprocess.run([sys.executable, "-c", "from importlinter.cli import lint_imports; "
+                          "raise SystemExit(lint_imports())"], cwd=ROOT, capture_output=True,
+                         text=True)
+    assert out.returncode == 0, out.stdout + out.stderr
+    assert "0 broken" in out.stdout
+
+
+def test_what_a_bots_process_needs_loads_no_numba_and_no_engine():
+    code = ("import sys\n"
+            "import spacewar.codes, spacewar.rules, spacewar.protocol, spacewar.wire, "
+            "spacewar.faults, spacewar.builtin_bots, spacewar.bots\n"
+            "print(sorted(m for m in ('numba', 'engine') if m in sys.modules))")
+    out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True,
+                         check=True)
+    assert out.stdout.strip() == "[]"
+
+
+def test_module_strings_name_what_is_there():
+    # names given as strings (a bot's process, a cluster worker's warm-up) are no imports the
+    # walk sees: they must resolve where the code now lives
+    import importlib
+
+    for target in ("spacewar.bothost:main", "spacewar.jobs:warm_up_game",
+                   "spacewar.tournament:warm_up_game", "spacewar.policy:Policy",
+                   "spacewar.sandbox_probe:Probe"):
+        module, name = target.split(":")
+        assert callable(getattr(importlib.import_module(module), name)), target
+
+
+# -- the check itself, on a package made to break it ----------------------------------------
+
+BROKEN = {
+    "__init__.py": "",
+    "low.py": """
+        def helper():
+            from .high import top  # upward, hidden in a function
+            return top()
+
+        def _secret():
+            return 1
+        """,
+    "high.py": """
+        from .low import _secret  # a private name of another module
+
+        def top():
+            return _secret()
+        """,
+    "ring_a.py": "from . import ring_b\n",
+    "ring_b.py": "from . import ring_a\n",
+}
+
+
+@pytest.fixture
+def broken(tmp_path):
+    package = tmp_path / "broken"
+    package.mkdir()
+    for name, text in BROKEN.items():
+        (package / name).write_text(textwrap.dedent(text))
+    (tmp_path / "pyproject.toml").write_text(textwrap.dedent("""
+        [tool.importlinter]
+        root_packages = ["broken"]
+
+        [[tool.importlinter.contracts]]
+        name = "broken: high above low"
+        type = "layers"
+        layers = ["broken.high", "broken.low", "broken.ring_a : broken.ring_b"]
+        """))
+    return tmp_path
+
+
+def test_the_walk_reports_an_upward_import_a_cycle_and_a_private_name(broken):
+    layers = declared_layers(broken / "pyproject.toml", "broken")
+    assert layers == {"broken.high": 2, "broken.low": 1, "broken.ring_a": 0, "broken.ring_b": 0}
+    problems = layer_violations(str(broken), "broken", layers)
+    (up,) = problems["upward"]
+    assert (up.source, up.target, up.names, up.local) == ("broken.low", "broken.high", ("top",),
+                                                          True)
+    assert problems["cycles"] == [["broken.high", "broken.low"], ["broken.ring_a", "broken.ring_b"]]
+    (private,) = problems["private"]
+    assert (private.source, private.target, private.names) == ("broken.high", "broken.low",
+                                                               ("_secret",))
+    assert problems["unplaced"] == []
+
+
+def test_import_linter_reports_the_upward_import_too(broken):
+    out = subprocess.run([sys.executable, "-c", "from importlinter.cli import lint_imports; "
+                          "raise SystemExit(lint_imports())"], cwd=broken, capture_output=True,
+                         text=True, env={**os.environ, "PYTHONPATH": str(broken)})
+    assert out.returncode != 0
+    assert "broken.low -> broken.high" in out.stdout, out.stdout
