@@ -168,7 +168,7 @@ def _add_window_commands(sub):
 
 def _gif_size(text):
     """``--size``: a GIF side the renderer accepts, refused with the reason before any work."""
-    from .render import MAX_SIZE, MIN_SIZE
+    from .paint_pil import MAX_SIZE, MIN_SIZE
 
     try:
         return _int(text, MIN_SIZE, MAX_SIZE)
@@ -499,7 +499,7 @@ def _cmd_replay(args):
         return 1
     if args.view:
         return _in_window("replay", _view_replay, data, args)
-    from .render import render_gif
+    from .gif import render_gif
 
     check_output_path(args.gif, "gif")
     render_gif(data, args.gif, every=args.every, size=args.size)

@@ -350,7 +350,7 @@ class SpacewarEnv(gymnasium.Env):
     def _start_drawing(self):
         self._effects = None
         if self.render_mode is not None:
-            from .render import Effects
+            from .scene import Effects
 
             self._effects = Effects()
             self._effects.update(self.game.snapshot(0))
@@ -361,7 +361,8 @@ class SpacewarEnv(gymnasium.Env):
         """``rgb_array``: the frame as (size, size, 3) uint8; ``human``: draws the window."""
         if self.render_mode is None or self._vector.batch is None:
             return None
-        from .render import render_frame, scene
+        from .paint_pil import render_frame
+        from .scene import scene
 
         snapshot = self.game.snapshot(0)
         names = ("learner", _name(self._vector.opponent))

@@ -36,7 +36,8 @@ from .faults import FAULT_KINDS, printable
 from .match import DEFAULT_MAX_FAULTS, bot_seed, checked_limits, cpu_seconds, match_result
 from .protocol import Action, raw_length
 from .referee import Referee
-from .render import DIM_TEXT, TEXT, Effects, frame_snapshot, scene
+from .look import DIM_TEXT, TEXT
+from .scene import Effects, frame_snapshot, scene
 from .rules import Rules
 from .seats import bot_name, open_seat
 from .viewer import (WATCH_SCREEN_HELP, Pace, Window, blend, check_display, check_speed,

@@ -27,8 +27,8 @@ import sys
 import time
 
 from . import keys as K
-from .render import (DIM_TEXT, SHIP_COLOURS, TEXT, VIZ_HINT, Effects, footer_pixels, footer_top,
-                     frame_snapshot, scene)
+from .look import DIM_TEXT, SHIP_COLOURS, TEXT, VIZ_HINT
+from .scene import Effects, footer_pixels, footer_top, frame_snapshot, scene
 
 RENDER_CAP = 120  # most drawn frames a second
 HEADLESS_DRIVERS = ("dummy", "offscreen")  # SDL drivers that draw nowhere
@@ -71,7 +71,7 @@ def require_pygame():
 
 
 def paint(pygame, surface, prims, fonts):
-    """Paint ``spacewar.render.scene`` primitives on a pygame surface (``fonts``: a dict this
+    """Paint ``spacewar.scene.scene`` primitives on a pygame surface (``fonts``: a dict this
     function fills, kept by the caller between frames)."""
     surface.fill((0, 0, 0))
     for p in prims:

@@ -117,7 +117,9 @@ def test_a_crash_mid_render_leaves_no_partial_file(tmp_path, replay, monkeypatch
     out = tmp_path / "keep.gif"
     out.write_bytes(b"GIF89a the previous file")  # a GIF may be replaced by a new GIF
     calls = {"n": 0}
-    real = render.render_frame
+    from spacewar import gif
+
+    real = gif.render_frame
 
     def failing(*args, **kwargs):
         calls["n"] += 1
@@ -125,7 +127,7 @@ def test_a_crash_mid_render_leaves_no_partial_file(tmp_path, replay, monkeypatch
             raise RuntimeError("boom")
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(render, "render_frame", failing)
+    monkeypatch.setattr(gif, "render_frame", failing)  # the GIF writer's own name for it
     with pytest.raises(RuntimeError, match="boom"):
         render_gif(replay, out, size=SIZE)
     assert out.read_bytes() == b"GIF89a the previous file"
