@@ -69,7 +69,7 @@ class ReplayTimeline:
         self.replay = replay
         self.actions = replay_io.actions(replay)  # (total, 2) int64 codes
         self.total = int(self.actions.shape[0])
-        self.game = replay_io._game(replay)
+        self.game = replay_io.new_game(replay)
         self.frame = 0
         self.checkpoints = {0: self.game.checkpoint(0)}  # frame -> Checkpoint, periodic
         self.segment = {}  # frame -> Checkpoint, the frames before the last backward target

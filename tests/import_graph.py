@@ -139,6 +139,36 @@ def cycles(graph_edges):
     return sorted(found)
 
 
+def private_attributes(root, package):
+    """``(module, target, name, line)`` wherever a module of the package reads a ``_private``
+    attribute of another module of it through the name it imported that module as
+    (``from . import replay as r`` ... ``r._game``): a private import by another road."""
+    known = modules(root, package)
+    found = []
+    for module, path in known.items():
+        with open(path, encoding="utf-8") as f:
+            tree = ast.parse(f.read(), path)
+        is_package = path.endswith("__init__.py")
+        aliases = {}
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Import):
+                for alias in node.names:
+                    if alias.name in known and alias.asname:
+                        aliases[alias.asname] = alias.name
+            elif isinstance(node, ast.ImportFrom):
+                base = _absolute(module, is_package, node)
+                for alias in node.names:
+                    sub = f"{base}.{alias.name}"
+                    if sub in known:
+                        aliases[alias.asname or alias.name] = sub
+        for node in ast.walk(tree):
+            if (isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name)
+                    and node.value.id in aliases and node.attr.startswith("_")
+                    and not node.attr.startswith("__") and aliases[node.value.id] != module):
+                found.append((module, aliases[node.value.id], node.attr, node.lineno))
+    return found
+
+
 def private_imports(graph_edges):
     """The edges that take a ``_private`` name from another module (``__dunder__`` names are
     not private)."""

@@ -37,7 +37,9 @@ def layer_violations(root, package, layers):
                 if m != package and not _placed(m, layers)]
     placed = [e for e in found if _placed(e.source, layers) and _placed(e.target, layers)]
     return {"upward": import_graph.upward(placed, layers), "cycles": import_graph.cycles(found),
-            "private": import_graph.private_imports(found), "unplaced": unplaced}
+            "private": import_graph.private_imports(found),
+            "private_attributes": import_graph.private_attributes(root, package),
+            "unplaced": unplaced}
 
 
 def _placed(module, layers):
@@ -51,13 +53,15 @@ def _placed(module, layers):
 def test_every_spacewar_import_points_down_and_none_is_private_or_circular():
     layers = declared_layers()
     problems = layer_violations(ROOT, "spacewar", layers)
-    assert problems == {"upward": [], "cycles": [], "private": [], "unplaced": []}
+    assert problems == {"upward": [], "cycles": [], "private": [], "private_attributes": [],
+                        "unplaced": []}
 
 
 def test_validation_has_no_cycle_and_takes_no_private_name():
     found = import_graph.edges(ROOT, "validation")
     assert import_graph.cycles(found) == []
     assert import_graph.private_imports(found) == []
+    assert import_graph.private_attributes(ROOT, "validation") == []
 
 
 def test_the_import_linter_contracts_hold():
@@ -103,10 +107,14 @@ BROKEN = {
             return 1
         """,
     "high.py": """
+        from . import low as low_module
         from .low import _secret  # a private name of another module
 
         def top():
             return _secret()
+
+        def peek():
+            return low_module._secret()  # the same, through the module's name
         """,
     "ring_a.py": "from . import ring_b\n",
     "ring_b.py": "from . import ring_a\n",
@@ -142,6 +150,7 @@ def test_the_walk_reports_an_upward_import_a_cycle_and_a_private_name(broken):
     (private,) = problems["private"]
     assert (private.source, private.target, private.names) == ("broken.high", "broken.low",
                                                                ("_secret",))
+    assert problems["private_attributes"] == [("broken.high", "broken.low", "_secret", 9)]
     assert problems["unplaced"] == []
 
 
