@@ -22,7 +22,7 @@ import numpy as np
 import engine
 from engine.atomic import OutputPathError, atomic_write, check_output_dir, check_output_path
 
-from . import contact, drift, hardcases, plots, sweeps, tree_bench, twobody
+from . import contact, energy_drift, hard_cases, plots, tree_bench, two_body, work_precision
 from .jobs import Job, run_jobs
 from .problems import kepler, make_sim
 from .reference import rebound_version
@@ -66,13 +66,13 @@ def collect(level, workers=2, progress=True, sections=SECTIONS, scheduler=None):
         jobs.append(Job(("crosscheck",), "crosscheck:run", dict(orbits=level.cross_orbits),
                         cost=level.cross_orbits * 2000))
     if "two_body" in sections:
-        jobs += twobody.jobs(level)
+        jobs += two_body.jobs(level)
     if "energy_drift" in sections:
-        jobs += drift.jobs(level)
+        jobs += energy_drift.jobs(level)
     if "hard_cases" in sections:
-        jobs += hardcases.jobs(level)
+        jobs += hard_cases.jobs(level)
     if "work_precision" in sections:
-        jobs += sweeps.reference_jobs(level)
+        jobs += work_precision.reference_jobs(level)
     if "contact" in sections:
         jobs += contact_jobs(level)
     t_a = time.perf_counter()
@@ -84,21 +84,21 @@ def collect(level, workers=2, progress=True, sections=SECTIONS, scheduler=None):
     if "crosscheck" in sections:
         out["crosscheck"] = results[("crosscheck",)]
     if "two_body" in sections:
-        out["two_body"] = twobody.assemble(level, results)
+        out["two_body"] = two_body.assemble(level, results)
     if "energy_drift" in sections:
-        out["energy_drift"] = drift.assemble(level, results)
+        out["energy_drift"] = energy_drift.assemble(level, results)
     phase_b = 0.0
     if "work_precision" in sections:
         t_b = time.perf_counter()
-        timed = sweeps.timed_jobs(level)
+        timed = work_precision.timed_jobs(level)
         for job in timed:
             job.kwargs.update(ref=results[("wp_ref", job.key[1])], level=level)
         sweep_results, _ = run_jobs(timed, workers=1, desc="timed sweeps", disable=not progress)
-        out["work_precision"] = sweeps.assemble(level, results, sweep_results)
-        sweeps.head_to_head(level, out["work_precision"])
+        out["work_precision"] = work_precision.assemble(level, results, sweep_results)
+        work_precision.head_to_head(level, out["work_precision"])
         phase_b = time.perf_counter() - t_b
     if "hard_cases" in sections:
-        out["hard_cases"] = hardcases.assemble(level, results)
+        out["hard_cases"] = hard_cases.assemble(level, results)
     if "contact" in sections:
         out["contact"] = {"gas": {f"{dim}-D": results[("contact", "gas", dim)]
                                   for dim in contact.GAS},
@@ -137,7 +137,7 @@ def meta(level, workers, scheduler=None):
         "machine": platform.machine(), "cpu_count": os.cpu_count(), "workers": workers,
         "scheduler": scheduler,
         "integrators": list(engine.integrators.GENERAL),
-        "work_precision_methods": {m.key: m.description for m in sweeps.METHODS.values()},
+        "work_precision_methods": {m.key: m.description for m in work_precision.METHODS.values()},
         "force_evaluations_per_step": dict(engine.integrators.FORCE_EVALUATIONS),
     }
 
@@ -459,8 +459,8 @@ def section_drift(sec, level, fig):
     lines.append("")
     lines.append(
         "**Growth exponent**: slope of log(running maximum of the error) against log(t) over the "
-        f"last {drift.FIT_DECADES:g} decades of the run (ending where the error first passes "
-        f"{drift.DESTROYED:g}: the orbit is then no longer the one it started on). Classes: < 0.25 "
+        f"last {energy_drift.FIT_DECADES:g} decades of the run (ending where the error first passes "
+        f"{energy_drift.DESTROYED:g}: the orbit is then no longer the one it started on). Classes: < 0.25 "
         "bounded; 0.25-0.75 a "
         "round-off random walk if the error is below 1e-11 (Brouwer's law, t^1/2), otherwise "
         "sublinear growth; 0.75-1.25 linear drift; > 1.25 faster than linear; too short to fit "
@@ -476,7 +476,7 @@ def section_drift(sec, level, fig):
             unit = entry["time_unit"]
             win_s = "—" if win is None else f"{g(win[0] / unit)}-{g(win[1] / unit)}"
             note = "" if run["destroyed_at"] is None else \
-                f"error > {drift.DESTROYED:g} from t = {g(run['destroyed_at'] / unit)}"
+                f"error > {energy_drift.DESTROYED:g} from t = {g(run['destroyed_at'] / unit)}"
             if run["status"] != "ok":
                 note = (note + "; " if note else "") + run["status"]
             rows.append([name, run["setting"], run["steps"], f(run["final_error"]),
@@ -530,7 +530,7 @@ def drift_findings(sec):
             if eu["destroyed_at"]:
                 when = g(eu["destroyed_at"] / entry["time_unit"])
                 parts.append(f"Explicit Euler at {eu['setting']} passes an energy error of "
-                             f"{drift.DESTROYED:g} at t = {when} {entry['time_unit_name']}s; its "
+                             f"{energy_drift.DESTROYED:g} at t = {when} {entry['time_unit_name']}s; its "
                              "fit ends there.")
     return "**Findings.** " + " ".join(parts)
 
@@ -562,7 +562,7 @@ def section_work_precision(sec, figs):
         "and change from run to run; the force-evaluation counts do not.")
     lines.append("")
     lines.append("Methods: " + "; ".join(
-        f"`{label_of(m.key)}` = {m.description}" for m in sweeps.METHODS.values()
+        f"`{label_of(m.key)}` = {m.description}" for m in work_precision.METHODS.values()
         if m.name != m.description) + ". The engine's `whfast` and `saba` need a dominant mass "
         "or a fixed attractor: elsewhere the engine refuses them and they are listed as "
         "skipped, as are REBOUND's corrected WHFast and SABAC4 (REBOUND's uncorrected WHFast "

@@ -453,35 +453,35 @@ def jobs(level):
     for name in engine.integrators.GENERAL:
         adaptive = name == "rk45"
         for s in ADAPTIVE["e099"] if adaptive else level.hc_e099_steps:
-            out.append(Job(("hc", "e099", name, s), "hardcases:e099_job",
+            out.append(Job(("hc", "e099", name, s), "hard_cases:e099_job",
                            dict(integrator=name, setting=s, orbits=level.hc_e099_orbits),
                            cost=1e5 if adaptive else s * level.hc_e099_orbits))
         for s in ADAPTIVE["pythagorean"] if adaptive else level.hc_pyth_dts:
-            out.append(Job(("hc", "pythagorean", name, s), "hardcases:pythagorean_job",
+            out.append(Job(("hc", "pythagorean", name, s), "hard_cases:pythagorean_job",
                            dict(integrator=name, setting=s),
                            cost=3e5 if adaptive else (70 / s) * 3))
         for s in ADAPTIVE["figure_eight"] if adaptive else level.hc_fig8_steps:
-            out.append(Job(("hc", "figure_eight", name, s), "hardcases:figure_eight_job",
+            out.append(Job(("hc", "figure_eight", name, s), "hard_cases:figure_eight_job",
                            dict(integrator=name, setting=s, periods=level.hc_fig8_periods),
                            cost=level.hc_fig8_periods * (300 if adaptive else s) * 3))
         for k in level.hc_spring_ks:
-            out.append(Job(("hc", "spring_outcome", name, k), "hardcases:spring_outcome_job",
+            out.append(Job(("hc", "spring_outcome", name, k), "hard_cases:spring_outcome_job",
                            dict(integrator=name, k=k, dt=0.01, steps=10_000),
                            cost=1e4 * (math.sqrt(k) if adaptive else 1)))
             if not adaptive:
-                out.append(Job(("hc", "spring_limit", name, k), "hardcases:spring_limit_job",
+                out.append(Job(("hc", "spring_limit", name, k), "hard_cases:spring_limit_job",
                                dict(integrator=name, k=k, steps=level.hc_spring_steps,
                                     iterations=level.hc_bisect_iterations),
                                cost=level.hc_spring_steps * (level.hc_bisect_iterations + 20)))
         for s in ADAPTIVE["flyby"] if adaptive else level.hc_flyby_dts:
-            out.append(Job(("hc", "flyby", name, s), "hardcases:flyby_job",
+            out.append(Job(("hc", "flyby", name, s), "hard_cases:flyby_job",
                            dict(integrator=name, setting=s), cost=1e4 if adaptive else 2 / s))
         for variant, soft, dt, _ in COINCIDENT_ROWS:
-            out.append(Job(("hc", "coincident", name, (variant, soft)), "hardcases:coincident_job",
+            out.append(Job(("hc", "coincident", name, (variant, soft)), "hard_cases:coincident_job",
                            dict(integrator=name, variant=variant, softening=soft, dt=dt), cost=2e4))
-    out.append(Job(("hc", "pythagorean", "ias15", 1e-9), "hardcases:pythagorean_job",
+    out.append(Job(("hc", "pythagorean", "ias15", 1e-9), "hard_cases:pythagorean_job",
                    dict(integrator="ias15", setting=1e-9, code="rebound"), cost=1e4))
-    out.append(Job(("hc", "flyby", "ias15", 1e-9), "hardcases:flyby_job",
+    out.append(Job(("hc", "flyby", "ias15", 1e-9), "hard_cases:flyby_job",
                    dict(integrator="ias15", setting=1e-9), cost=1e3))
     return out
 

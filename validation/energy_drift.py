@@ -109,14 +109,14 @@ def jobs(level):
     common = f"{n_per} steps/orbit"
     for name in engine.integrators.GENERAL:
         if name == "rk45":
-            out.append(Job(("drift", "kepler", "engine", name, ""), "drift:run_engine_adaptive",
+            out.append(Job(("drift", "kepler", "engine", name, ""), "energy_drift:run_engine_adaptive",
                            dict(problem=p, tolerance=level.drift_tolerance,
                                 t_end=level.drift_orbits * p.unit, t_first=0.01 * p.unit,
                                 samples=level.drift_samples, dt0=p.unit / 100,
                                 setting=f"tol {level.drift_tolerance:g}"),
                            cost=level.drift_orbits * 200 * 6))
             continue
-        out.append(Job(("drift", "kepler", "engine", name, ""), "drift:run_engine_fixed",
+        out.append(Job(("drift", "kepler", "engine", name, ""), "energy_drift:run_engine_fixed",
                        dict(problem=p, integrator=name, dt=p.unit / n_per, total_steps=total,
                             samples=level.drift_samples, first_steps=max(1, n_per // 100),
                             setting=common, stop_above=1.0 if name == "euler" else None),
@@ -124,18 +124,18 @@ def jobs(level):
                        * (0.01 if name == "euler" else 1)))
         if name == "euler":  # and at a much smaller step, where its orbit survives longer
             ne = level.drift_euler_steps_per_orbit
-            out.append(Job(("drift", "kepler", "engine", name, "fine"), "drift:run_engine_fixed",
+            out.append(Job(("drift", "kepler", "engine", name, "fine"), "energy_drift:run_engine_fixed",
                            dict(problem=p, integrator=name, dt=p.unit / ne,
                                 total_steps=int(level.drift_euler_orbits * ne),
                                 samples=level.drift_samples, first_steps=max(1, ne // 100),
                                 setting=f"{ne} steps/orbit", stop_above=1.0),
                            cost=level.drift_euler_orbits * ne))
-    out.append(Job(("drift", "kepler", "rebound", "ias15", ""), "drift:run_rebound",
+    out.append(Job(("drift", "kepler", "rebound", "ias15", ""), "energy_drift:run_rebound",
                    dict(problem=p, integrator="ias15", t_end=level.drift_orbits * p.unit,
                         t_first=0.01 * p.unit, samples=level.drift_samples,
                         setting="epsilon 1e-9 (default)"),
                    cost=level.drift_orbits * 60 * 10))
-    out.append(Job(("drift", "kepler", "rebound", "whfast", ""), "drift:run_rebound",
+    out.append(Job(("drift", "kepler", "rebound", "whfast", ""), "energy_drift:run_rebound",
                    dict(problem=p, integrator="whfast", t_end=level.drift_orbits * p.unit,
                         t_first=0.01 * p.unit, samples=level.drift_samples, dt=p.unit / n_per,
                         total_steps=total, setting=common), cost=total * 0.5))
@@ -146,21 +146,21 @@ def jobs(level):
     common = f"dt = {dt:g} d"
     for name in engine.integrators.GENERAL:
         if name == "rk45":
-            out.append(Job(("drift", "solar", "engine", name, ""), "drift:run_engine_adaptive",
+            out.append(Job(("drift", "solar", "engine", name, ""), "energy_drift:run_engine_adaptive",
                            dict(problem=s, tolerance=level.drift_tolerance,
                                 t_end=level.drift_solar_days, t_first=dt,
                                 samples=level.drift_samples, dt0=dt,
                                 setting=f"tol {level.drift_tolerance:g}"),
                            cost=total * 6 * 5))
         else:
-            out.append(Job(("drift", "solar", "engine", name, ""), "drift:run_engine_fixed",
+            out.append(Job(("drift", "solar", "engine", name, ""), "energy_drift:run_engine_fixed",
                            dict(problem=s, integrator=name, dt=dt, total_steps=total,
                                 samples=level.drift_samples, setting=common),
                            cost=total * engine.integrators.FORCE_EVALUATIONS[name] * 5))
-    out.append(Job(("drift", "solar", "rebound", "ias15", ""), "drift:run_rebound",
+    out.append(Job(("drift", "solar", "rebound", "ias15", ""), "energy_drift:run_rebound",
                    dict(problem=s, integrator="ias15", t_end=level.drift_solar_days, t_first=dt,
                         samples=level.drift_samples, setting="epsilon 1e-9 (default)"), cost=total))
-    out.append(Job(("drift", "solar", "rebound", "whfast", ""), "drift:run_rebound",
+    out.append(Job(("drift", "solar", "rebound", "whfast", ""), "energy_drift:run_rebound",
                    dict(problem=s, integrator="whfast", t_end=level.drift_solar_days, t_first=dt,
                         samples=level.drift_samples, dt=dt, total_steps=total, setting=common),
                    cost=total))

@@ -224,7 +224,7 @@ def reference_job(problem):
 
 
 def reference_jobs(level):
-    return [Job(("wp_ref", p.key), "sweeps:reference_job", dict(problem=p), cost=50)
+    return [Job(("wp_ref", p.key), "work_precision:reference_job", dict(problem=p), cost=50)
             for p in work_precision_set(level)]
 
 
@@ -464,11 +464,11 @@ def timed_jobs(level):
     out = []
     for p in work_precision_set(level):
         for m in ENGINE_METHODS:
-            out.append(Job(("wp", p.key, "engine", m.name), "sweeps:sweep_engine",
+            out.append(Job(("wp", p.key, "engine", m.name), "work_precision:sweep_engine",
                            dict(problem=p, method=m.name)))
         if p.rebound:
             for m in REBOUND_METHOD_LIST:
-                out.append(Job(("wp", p.key, "rebound", m.name), "sweeps:sweep_rebound",
+                out.append(Job(("wp", p.key, "rebound", m.name), "work_precision:sweep_rebound",
                                dict(problem=p, method=m.name)))
     return out
 

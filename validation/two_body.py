@@ -60,18 +60,18 @@ def jobs(level):
         for n in level.tb_steps_per_orbit:
             dt = problem.unit / n
             for name in FIXED:
-                out.append(Job(("two_body", problem.key, "engine", name, n), "twobody:run_engine",
+                out.append(Job(("two_body", problem.key, "engine", name, n), "two_body:run_engine",
                                dict(problem=problem, integrator=name, times=times, dt=dt),
                                cost=n * top * engine.integrators.FORCE_EVALUATIONS[name]))
             for name in REBOUND_FIXED:
-                out.append(Job(("two_body", problem.key, "rebound", name, n), "twobody:run_rebound",
+                out.append(Job(("two_body", problem.key, "rebound", name, n), "two_body:run_rebound",
                                dict(problem=problem, integrator=name, times=times, dt=dt),
                                cost=n * top * 0.3))
         for tol in level.tb_tolerances:
-            out.append(Job(("two_body", problem.key, "engine", "rk45", tol), "twobody:run_engine",
+            out.append(Job(("two_body", problem.key, "engine", "rk45", tol), "two_body:run_engine",
                            dict(problem=problem, integrator="rk45", times=times,
                                 dt=problem.unit / 100, tolerance=tol), cost=top * 3000))
-        out.append(Job(("two_body", problem.key, "rebound", "ias15", "ref"), "twobody:run_rebound",
+        out.append(Job(("two_body", problem.key, "rebound", "ias15", "ref"), "two_body:run_rebound",
                        dict(problem=problem, integrator="ias15", times=times,
                             epsilon=IAS15_REFERENCE_EPSILON), cost=top * 500))
     return out
