@@ -192,3 +192,13 @@ def test_main_dispatches_report_without_importing_bench():
                          check=True, env={"PYTHONPATH": str(ROOT), "PATH": "/usr/bin:/bin"})
     assert out.stdout.strip().splitlines()[-1] == "0 False"
     assert "--quick" in out.stdout
+
+
+def test_the_former_module_names_are_the_same_modules():
+    """The study modules bear their sections' names; the former names import the very same
+    modules (so a monkeypatch through either reaches both)."""
+    import importlib
+
+    for old, new in (("twobody", two_body), ("drift", energy_drift), ("hardcases", hard_cases),
+                     ("sweeps", importlib.import_module("validation.work_precision"))):
+        assert importlib.import_module(f"validation.{old}") is new
