@@ -13,14 +13,25 @@ too: what a scene that declares none pays.
 """
 import math
 import statistics
-import time
+import sys
 
 import numpy as np
+
+from .timing import timed
+
+NAME = "contact"
+KEYS = ("contact",)
+NEEDS = ("rebound",)
 
 #: sphere radius, volume fraction, step, by the module doc
 RADIUS, PACKING, DT = 0.5, 0.1, 0.02
 
 SIZES = {"quick": (1000, 10_000), "full": (1000, 10_000, 100_000)}
+
+
+def run(quick):
+    return {"contact": measure(SIZES["quick" if quick else "full"], repeats=3,
+                               progress=lambda text: print(text, file=sys.stderr))}
 
 
 def scene(n, seed=1):
@@ -65,12 +76,6 @@ def rebound_gas(n, seed=1):
     return sim
 
 
-def _timed(fn):
-    t = time.perf_counter()
-    fn()
-    return time.perf_counter() - t
-
-
 def measure(sizes, repeats=3, progress=None):
     """The section's figures at each N: per-step times of the engine with and without
     collisions and of REBOUND, the median ratio, contacts per step, and the fitted exponent of
@@ -84,12 +89,12 @@ def measure(sizes, repeats=3, progress=None):
         t_ours, t_theirs, t_bare, ratios, contacts = [], [], [], [], 0
         log_before = theirs.collisions_log_n
         for _ in range(repeats):
-            a = _timed(lambda: ours.step(steps))
+            a = timed(lambda: ours.step(steps))
             contacts += len(ours.contacts)
-            b = _timed(lambda: theirs.steps(steps))
+            b = timed(lambda: theirs.steps(steps))
             t_ours.append(a / steps)
             t_theirs.append(b / steps)
-            t_bare.append(_timed(lambda: bare.step(steps)) / steps)
+            t_bare.append(timed(lambda: bare.step(steps)) / steps)
             ratios.append(b / a)
         rows.append({
             "n": n, "steps": steps * repeats,
@@ -159,3 +164,11 @@ def markdown_contact(r):
     if c["exponent"] is not None:
         out += ["", f"Fitted engine time ~ N^a: a = {c['exponent']:.2f}."]
     return out + [""]
+
+
+def text(r):
+    return [format_contact(r)]
+
+
+def markdown(r):
+    return markdown_contact(r)

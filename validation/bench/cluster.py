@@ -15,7 +15,15 @@ import os
 import pickle
 import time
 
+NAME = "cluster"
+KEYS = ("cluster",)
+NEEDS = ()
+
 BOTS = ["chaser", "sniper", "dodger", "random"]
+
+
+def run(quick):
+    return {"cluster": bench_cluster(quick)}
 
 
 def _noop(i):
@@ -162,3 +170,16 @@ def markdown_cluster(c):
               f"{s['local_seconds']:.1f} s on local processes, {s['cluster_seconds']:.1f} s on a "
               f"LocalCluster of 2 workers; identical results: **{s['identical']}**."]
     return lines
+
+
+def text(r):
+    return (["\n10. tournaments and sweeps on Dask (local processes against a LocalCluster)"]
+            + format_cluster(r["cluster"]))
+
+
+def markdown(r):
+    return ["## 10. Tournaments and sweeps on Dask", ""] + markdown_cluster(r["cluster"]) + [""]
+
+
+def targets(r):
+    return []
