@@ -1,7 +1,8 @@
 """The bench's results as text (what ``python -m validation bench`` prints) and as Markdown
 (``docs/performance.md``): the machine, the targets against this run's figures, and each
 section's part in the sections' order."""
-from .registry import MODULES, TARGETS_BEFORE, chosen
+from . import registry
+from .registry import chosen
 
 HOW_THE_TARGETS_ARE_MET = """How the engine gets there (the figures are this run's, in the tables below):
 
@@ -69,8 +70,8 @@ def targets(r):
 def _in_targets_order(modules):
     """``modules`` in the sections' order, but each section ``TARGETS_BEFORE`` names just
     before the section it names."""
-    order = [module.NAME for module in MODULES]
-    for name, before in TARGETS_BEFORE.items():
+    order = [module.NAME for module in registry.MODULES]
+    for name, before in registry.TARGETS_BEFORE.items():
         order.remove(name)
         order.insert(order.index(before), name)
     return sorted(modules, key=lambda module: order.index(module.NAME))

@@ -1,6 +1,7 @@
 """``report.md``: its header and contents, "At a glance", each section's part in the report's
 order, and how to reproduce it."""
-from .registry import MODULES, chosen
+from . import registry
+from .registry import chosen
 from .text import seconds
 
 
@@ -18,8 +19,8 @@ def markdown(res, level, figs):
         f"{m['python_version']}, {m['machine']}, {m['cpu_count']} cores. Every number below is "
         "in `results.json`.")
     parts.append("")
-    parts.append("Contents: at a glance; " + "; ".join(module.CONTENTS for module in MODULES)
-                 + ".")
+    parts.append("Contents: at a glance; "
+                 + "; ".join(module.CONTENTS for module in registry.MODULES) + ".")
     parts.append("")
     parts.append(section_glance(res, level))
     for module in chosen(res):
