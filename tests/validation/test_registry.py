@@ -8,8 +8,8 @@ import pytest
 from validation import bench
 from validation.bench import registry as bench_registry
 
-REPORT_DECLARES = ("NAME", "CONTENTS", "PHASE", "FILES", "jobs", "gather", "plots", "markdown",
-                   "glance")
+REPORT_DECLARES = ("NAME", "CONTENTS", "PHASE", "FIGURES", "jobs", "gather", "plots",
+                   "markdown", "glance")
 BENCH_DECLARES = ("NAME", "KEYS", "NEEDS", "run", "text", "markdown", "targets")
 
 
@@ -30,8 +30,8 @@ def test_every_report_section_declares_the_whole_interface(report):
         missing = [name for name in REPORT_DECLARES if not hasattr(module, name)]
         assert not missing, f"{module.__name__} does not declare {missing}"
         assert module.PHASE in registry.PHASES
-        assert set(module.FILES.values()) <= {"png"}
-    files = [name for module in registry.MODULES for name in module.FILES]
+        assert all(name.endswith(".png") for name in module.FIGURES.values())
+    files = [name for module in registry.MODULES for name in module.FIGURES.values()]
     assert len(files) == len(set(files))
     assert list(report.output_files()) == ["report.md", "results.json"] + files
 
@@ -55,7 +55,8 @@ def _fake_report_section():
         return {"figure": "fake.png"}
 
     return types.SimpleNamespace(
-        NAME="fake", CONTENTS="8. A fake section", PHASE="untimed", FILES={"fake.png": "png"},
+        NAME="fake", CONTENTS="8. A fake section", PHASE="untimed",
+        FIGURES={"figure": "fake.png"},
         jobs=lambda level: [], gather=lambda level, results, progress: {"answer": 42},
         plots=plots,
         markdown=lambda sec, level, figs: f"## 8. Fake: {sec['answer']} ({figs['figure']})\n",

@@ -41,7 +41,7 @@ def output_files(sections=SECTIONS):
     """The files ``write`` produces in the output directory, with their kinds."""
     files = {"report.md": "markdown", "results.json": "json"}
     for module in chosen(sections):
-        files.update(module.FILES)
+        files.update(dict.fromkeys(module.FIGURES.values(), "png"))
     return files
 
 

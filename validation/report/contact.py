@@ -12,7 +12,6 @@ NAME = "contact"
 CONTENTS = "7. Contact: a hard-sphere gas and an accreting disk"
 PHASE = "untimed"
 FIGURES = {"contact": "contact.png"}
-FILES = {name: "png" for name in FIGURES.values()}
 
 
 def jobs(level):

@@ -6,7 +6,7 @@ from .text import f, g, table
 NAME = "crosscheck"
 CONTENTS = "1. leapfrog cross-check with REBOUND"
 PHASE = "untimed"
-FILES = {}
+FIGURES = {}
 
 
 def jobs(level):

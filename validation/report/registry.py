@@ -5,8 +5,8 @@ Each section is a module of this package that declares, in one place:
 - ``NAME``: its key in ``results.json``, its word in ``--only`` and its module's name;
 - ``CONTENTS``: its entry in the report's list of contents;
 - ``PHASE``: when its results are made (``PHASES``);
-- ``FILES``: the files its ``plots`` writes whatever the results, by kind (checked before the
-  runs start: ``output_files``);
+- ``FIGURES``: the PNG files its ``plots`` writes whatever the results, by role (checked
+  before the runs start: ``output_files``);
 - ``jobs(level)``: its untimed runs (``validation.jobs.Job``), run on the worker processes or
   the cluster with every other section's;
 - ``gather(level, results, progress)``: its results, from the untimed runs' ``results`` (and,

@@ -11,7 +11,6 @@ NAME = "tree"
 CONTENTS = "6. Tree gravity (FMM and Barnes-Hut)"
 PHASE = "alone"  # timed: alone in this process, after everything else
 FIGURES = {"error": "tree_error.png", "time": "tree_time.png"}
-FILES = {name: "png" for name in FIGURES.values()}
 
 
 def jobs(level):

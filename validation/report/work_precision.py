@@ -10,7 +10,7 @@ from .text import f, g, label_of, seconds, table
 NAME = "work_precision"
 CONTENTS = "4. work-precision (choosing an integrator)"
 PHASE = "timed"
-FILES = {}  # one figure a problem: their names depend on the problems run
+FIGURES = {}  # one a problem, named after it: ``plots``
 
 
 def jobs(level):
