@@ -6,12 +6,11 @@ import argparse
 import importlib
 import sys
 
-#: the modules each command needs beyond the core install, and the extra that has them
+#: the modules each command needs beyond the core install, and the extra that has them (the
+#: bench's sections declare theirs: ``bench_needs``)
 NEEDS = {"report": ("rebound", "matplotlib"), "bench": ("rebound",), "advise": (),
          "compile-times": (), "theta-table": ()}
 EXTRA = "validation"
-#: the bench sections that time REBOUND side by side (the others run without it)
-BENCH_REBOUND_SECTIONS = frozenset({"direct", "small", "planets"})
 
 
 def _bench_sections(rest):
@@ -24,13 +23,21 @@ def _bench_sections(rest):
     return None
 
 
+def bench_needs(sections=None):
+    """The modules the bench's ``sections`` (words of ``--only``; None: every section) need,
+    as the sections declare them."""
+    from .bench.registry import MODULES
+
+    return tuple(dict.fromkeys(name for module in MODULES
+                               if sections is None or module.NAME in sections
+                               for name in module.NEEDS))
+
+
 def missing_modules(command, rest=()):
     """The modules ``command`` (with its arguments ``rest``) needs that cannot be imported."""
     needs = NEEDS[command]
     if command == "bench":
-        sections = _bench_sections(list(rest))
-        if sections is not None and not sections & BENCH_REBOUND_SECTIONS:
-            needs = ()
+        needs = bench_needs(_bench_sections(list(rest)))
     missing = []
     for name in needs:
         try:

@@ -16,7 +16,7 @@ def test_small_n_engine_computes_what_the_plain_loop_computes():
 
 
 def test_the_pair_kernel_and_the_both_ends_loop_it_is_timed_against_agree():
-    kernel_ms, both_ends_ms, ratio, difference = bench._kernel_against_both_ends(300, 1)
+    kernel_ms, both_ends_ms, ratio, difference = bench.kernel_against_both_ends(300, 1)
     assert difference < 1e-12
     assert kernel_ms > 0 and both_ends_ms > 0 and ratio > 0
 
@@ -57,14 +57,14 @@ def test_targets_are_judged_from_the_figures():
 
 
 def test_the_contact_section_solves_the_same_problem_as_rebound():
-    from validation import contact_bench
+    from validation.bench import contact
 
-    r = contact_bench.measure((600,), repeats=1)
+    r = contact.measure((600,), repeats=1)
     (row,) = r["rows"]
     assert row["engine_contacts_per_step"] > 1
     # the same gas, seen by two codes: about the same number of contacts a step
     assert abs(row["engine_contacts_per_step"] / row["rebound_contacts_per_step"] - 1) < 0.35
     report = {"contact": r}
-    assert contact_bench.targets(report) == []  # below 10^4, one size: no target judged
-    assert "12. Contact" in contact_bench.format_contact(report)
-    assert contact_bench.markdown_contact(report)[0].startswith("## 12. Contact")
+    assert contact.targets(report) == []  # below 10^4, one size: no target judged
+    assert "12. Contact" in contact.format_contact(report)
+    assert contact.markdown_contact(report)[0].startswith("## 12. Contact")

@@ -34,3 +34,13 @@ def test_bench_sections_without_rebound_need_no_extra(monkeypatch):
     assert missing_modules("bench", ["--only=learning"]) == []
     assert missing_modules("bench", ["--only", "spacewar,planets"]) == ["rebound"]
     assert missing_modules("bench", ["--quick"]) == ["rebound"]
+
+
+def test_the_bench_needs_what_its_sections_declare(monkeypatch):
+    from validation.__main__ import NEEDS, bench_needs, missing_modules
+
+    assert bench_needs() == NEEDS["bench"]
+    monkeypatch.setitem(sys.modules, "rebound", None)
+    # the contact section's gas runs in REBOUND too; the tree's skips a code that is missing
+    assert missing_modules("bench", ["--only", "contact"]) == ["rebound"]
+    assert missing_modules("bench", ["--only", "tree"]) == []

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from tests.engine.controls_energy import PumpedSim
-from validation import crosscheck, drift, hardcases, twobody
+from validation import crosscheck, energy_drift, hard_cases, two_body
 from validation.problems import kepler
 from validation.reference import ias15_states, kepler_states
 
@@ -49,7 +49,7 @@ def test_leapfrog_difference_is_the_size_of_each_codes_own_rounding(rebound):
 
 def _errors(problem, integrator, steps_per_orbit, orbits, tolerance=1e-9):
     times = [k * problem.unit for k in orbits]
-    run = twobody.run_engine(problem, integrator, times, problem.unit / steps_per_orbit, tolerance)
+    run = two_body.run_engine(problem, integrator, times, problem.unit / steps_per_orbit, tolerance)
     assert run["status"] == "ok"
     exact = kepler_states(problem, times)
     return [float(np.linalg.norm(s[0][0] - e[0][0]) / np.linalg.norm(e[0][0]))
@@ -90,18 +90,18 @@ def _drift(integrator, steps_per_orbit, orbits, pump=0.0, monkeypatch=None):
     positive control; needs ``monkeypatch``)."""
     p = kepler(0.6)
     if pump:
-        real = drift.make_sim
+        real = energy_drift.make_sim
 
         def pumped(*args, **kw):
             sim = real(*args, **kw)
             return PumpedSim(sim, pump, mean_kinetic=abs(sim.energy()))
 
-        monkeypatch.setattr(drift, "make_sim", pumped)
-    res = drift.run_engine_fixed(p, integrator, p.unit / steps_per_orbit,
+        monkeypatch.setattr(energy_drift, "make_sim", pumped)
+    res = energy_drift.run_engine_fixed(p, integrator, p.unit / steps_per_orbit,
                                  steps_per_orbit * orbits, 30,
                                  first_steps=max(1, steps_per_orbit // 100))
-    slope, window, env, destroyed = drift.growth_exponent(res["t"], res["err"])
-    return slope, drift.classify(slope, env, window), res
+    slope, window, env, destroyed = energy_drift.growth_exponent(res["t"], res["err"])
+    return slope, energy_drift.classify(slope, env, window), res
 
 
 # Leapfrog at 1000 steps an orbit over 1000 orbits (1e6 steps): its bounded error is 5.1e-5,
@@ -138,29 +138,29 @@ def test_drift_class_of_a_pumped_leapfrog_is_not_bounded(monkeypatch):
 
 def test_growth_exponent_of_synthetic_series():
     t = np.logspace(0, 5, 60)
-    assert drift.growth_exponent(t, 1e-3 * (1 + 0.5 * np.sin(t)))[0] == pytest.approx(0.0, abs=0.05)
-    assert drift.growth_exponent(t, 1e-9 * t)[0] == pytest.approx(1.0, abs=1e-9)
-    slope, _, _, destroyed = drift.growth_exponent(t, 1e-6 * t ** 2)
+    assert energy_drift.growth_exponent(t, 1e-3 * (1 + 0.5 * np.sin(t)))[0] == pytest.approx(0.0, abs=0.05)
+    assert energy_drift.growth_exponent(t, 1e-9 * t)[0] == pytest.approx(1.0, abs=1e-9)
+    slope, _, _, destroyed = energy_drift.growth_exponent(t, 1e-6 * t ** 2)
     assert destroyed is not None and slope == pytest.approx(2.0, abs=1e-9)
-    assert drift.classify(0.5, 1e-13) == "random walk (round-off)"
-    assert drift.classify(0.5, 1e-5) == "sublinear growth"
+    assert energy_drift.classify(0.5, 1e-13) == "random walk (round-off)"
+    assert energy_drift.classify(0.5, 1e-5) == "sublinear growth"
 
 
 # -- stiff spring ----------------------------------------------------------------------------------
 
 def test_stiff_spring_limit_matches_two_over_omega_for_leapfrog():
-    assert hardcases.theory_limit("leapfrog") == pytest.approx(2.0, abs=1e-9)
-    assert hardcases.theory_limit("rk4") == pytest.approx(2 * math.sqrt(2), abs=1e-9)
-    assert hardcases.theory_limit("euler") == 0.0
-    res = hardcases.spring_limit_job("leapfrog", k=1e4, steps=5000, iterations=14)
+    assert hard_cases.theory_limit("leapfrog") == pytest.approx(2.0, abs=1e-9)
+    assert hard_cases.theory_limit("rk4") == pytest.approx(2 * math.sqrt(2), abs=1e-9)
+    assert hard_cases.theory_limit("euler") == 0.0
+    res = hard_cases.spring_limit_job("leapfrog", k=1e4, steps=5000, iterations=14)
     assert res["limit"] == pytest.approx(2.0, abs=2e-3)
     assert res["limit_dt"] == pytest.approx(2.0 / math.sqrt(2e4), rel=1e-3)
 
 
 def test_coincident_bodies_are_detected_not_skipped():
-    res = hardcases.coincident_job("leapfrog", "exact", 0.0, 1e-3)
+    res = hard_cases.coincident_job("leapfrog", "exact", 0.0, 1e-3)
     assert res["outcome"] == "blows up"
-    res = hardcases.coincident_job("leapfrog", "exact", 0.01, 1e-3)
+    res = hard_cases.coincident_job("leapfrog", "exact", 0.01, 1e-3)
     assert res["outcome"] == "stable"
 
 
@@ -192,3 +192,16 @@ def test_main_dispatches_report_without_importing_bench():
                          check=True, env={"PYTHONPATH": str(ROOT), "PATH": "/usr/bin:/bin"})
     assert out.stdout.strip().splitlines()[-1] == "0 False"
     assert "--quick" in out.stdout
+
+
+def test_the_former_module_names_are_the_same_modules():
+    """The study modules bear their sections' names, and two bench sections moved into the
+    bench's package; the former names import the very same modules (so a monkeypatch through
+    either reaches both)."""
+    import importlib
+
+    for old, new in (("twobody", "two_body"), ("drift", "energy_drift"),
+                     ("hardcases", "hard_cases"), ("sweeps", "work_precision"),
+                     ("bench_cluster", "bench.cluster"), ("contact_bench", "bench.contact")):
+        assert importlib.import_module(f"validation.{old}") is \
+            importlib.import_module(f"validation.{new}")

@@ -4,7 +4,7 @@ import math
 
 import pytest
 
-from validation import bench, report, sweeps
+from validation import bench, report, work_precision
 from validation.problems import figure_eight, kepler, outer_solar_system
 from validation.settings import LEVELS
 
@@ -21,15 +21,15 @@ def rebound():
 # -- the new methods in a sweep --------------------------------------------------------------------
 
 def _sweep_all(problem, level=SMOKE):
-    ref = sweeps.reference_job(problem)
+    ref = work_precision.reference_job(problem)
     results = {}
-    for m in sweeps.ENGINE_METHODS:
-        results[("wp", problem.key, "engine", m.name)] = sweeps.sweep_engine(problem, m.name, ref,
+    for m in work_precision.ENGINE_METHODS:
+        results[("wp", problem.key, "engine", m.name)] = work_precision.sweep_engine(problem, m.name, ref,
                                                                               level)
-    for m in sweeps.REBOUND_METHOD_LIST:
-        results[("wp", problem.key, "rebound", m.name)] = sweeps.sweep_rebound(problem, m.name,
+    for m in work_precision.REBOUND_METHOD_LIST:
+        results[("wp", problem.key, "rebound", m.name)] = work_precision.sweep_rebound(problem, m.name,
                                                                                 ref, level)
-    return sweeps.assemble_problem(problem, ref, results)
+    return work_precision.assemble_problem(problem, ref, results)
 
 
 def test_new_methods_are_swept_on_both_sides(rebound):
@@ -67,19 +67,19 @@ def test_whfast_and_saba_are_skipped_without_a_dominant_mass(rebound):
     p = figure_eight(periods=1.0)
     ref = {"floor": 1e-12}  # never read: the methods are refused before any run
     for name in ("whfast", "whfast_c11", "saba", "sabac4"):
-        res = sweeps.sweep_engine(p, name, ref, SMOKE)
+        res = work_precision.sweep_engine(p, name, ref, SMOKE)
         assert res["points"] == []
         assert "dominant mass" in res["skipped"]
     for name in ("whfast_c11", "whfast_c17", "sabac4"):
-        res = sweeps.sweep_rebound(p, name, ref, SMOKE)
+        res = work_precision.sweep_rebound(p, name, ref, SMOKE)
         assert res["points"] == [] and "dominant mass" in res["skipped"]
     # a general method is not skipped, and a skip reaches the report
-    results = {("wp", p.key, "engine", "whfast"): sweeps.sweep_engine(p, "whfast", ref, SMOKE),
-               ("wp", p.key, "rebound", "sabac4"): sweeps.sweep_rebound(p, "sabac4", ref,
+    results = {("wp", p.key, "engine", "whfast"): work_precision.sweep_engine(p, "whfast", ref, SMOKE),
+               ("wp", p.key, "rebound", "sabac4"): work_precision.sweep_rebound(p, "sabac4", ref,
                                                                          SMOKE)}
-    ref = sweeps.reference_job(p)
-    results[("wp", p.key, "engine", "leapfrog")] = sweeps.sweep_engine(p, "leapfrog", ref, SMOKE)
-    entry = sweeps.assemble_problem(p, ref, results)
+    ref = work_precision.reference_job(p)
+    results[("wp", p.key, "engine", "leapfrog")] = work_precision.sweep_engine(p, "leapfrog", ref, SMOKE)
+    entry = work_precision.assemble_problem(p, ref, results)
     assert [s["method"] for s in entry["skipped"]] == ["engine:whfast", "rebound:sabac4"]
     assert {r["method"] for r in entry["runs"]} == {"engine:leapfrog"}
     text = report.skipped_text(entry["skipped"])
@@ -88,8 +88,8 @@ def test_whfast_and_saba_are_skipped_without_a_dominant_mass(rebound):
 
 
 def test_a_problem_with_a_dominant_mass_is_not_refused():
-    assert sweeps.dominant_mass_refusal(outer_solar_system(1e3)) is None
-    assert "dominant mass" in sweeps.dominant_mass_refusal(figure_eight(periods=1.0))
+    assert work_precision.dominant_mass_refusal(outer_solar_system(1e3)) is None
+    assert "dominant mass" in work_precision.dominant_mass_refusal(figure_eight(periods=1.0))
 
 
 # -- the table, from made-up points ----------------------------------------------------------------
@@ -110,7 +110,7 @@ def test_versus_picks_the_fastest_run_of_each_code_that_reaches_the_level():
         _run("rebound", "ias15", 0.006, 1e-11, setting=1e-9),
         _run("rebound", "leapfrog", 0.0005, float("nan")),  # non-finite error: never picked
     ]
-    rows = {row["level"]: row for row in sweeps.versus(runs, levels=(1e-2, 1e-6, 1e-8, 1e-10,
+    rows = {row["level"]: row for row in work_precision.versus(runs, levels=(1e-2, 1e-6, 1e-8, 1e-10,
                                                                      1e-12), floor=1e-11)}
     r = rows[1e-2]
     assert r["engine"]["method"] == "engine:leapfrog"
@@ -140,16 +140,16 @@ def test_head_to_head_times_each_pair_once_and_keeps_the_sweep_ratio(monkeypatch
     p_key = "kepler_e0.6"
     runs = [_run("engine", "leapfrog", 1.0, 1e-3, setting=200),
             _run("rebound", "leapfrog", 2.0, 1e-3, setting=200)]
-    section = {p_key: {"versus": sweeps.versus(runs, levels=(1e-2, 1e-1))}}
+    section = {p_key: {"versus": work_precision.versus(runs, levels=(1e-2, 1e-1))}}
     calls = []
-    real = sweeps.time_pair
+    real = work_precision.time_pair
 
     def counting(problem, e, r, level):
         calls.append((problem.key, e["method"], r["method"]))
         return real(p, e, r, level)
 
-    monkeypatch.setattr(sweeps, "time_pair", counting)
-    sweeps.head_to_head(SMOKE, section)
+    monkeypatch.setattr(work_precision, "time_pair", counting)
+    work_precision.head_to_head(SMOKE, section)
     assert calls == [(p_key, "engine:leapfrog", "rebound:leapfrog")]
     for row in section[p_key]["versus"]:
         assert row["sweep_ratio"] == pytest.approx(0.5)
@@ -188,13 +188,13 @@ def test_a_sweep_stops_at_its_round_off_plateau_not_at_a_lucky_error():
         return [{"error": e} for e in errors]
 
     floor = 1e-12
-    assert sweeps.converged(points(1e-3, 5e-13), floor)  # below the reference's uncertainty
-    assert not sweeps.converged(points(1e-3, 1e-5, 1e-7), floor)  # converging
+    assert work_precision.converged(points(1e-3, 5e-13), floor)  # below the reference's uncertainty
+    assert not work_precision.converged(points(1e-3, 1e-5, 1e-7), floor)  # converging
     # one lucky error, then the trend again: go on
-    assert not sweeps.converged(points(1e-6, 1e-10, 1e-8), floor)
-    assert not sweeps.converged(points(1e-10, 1e-8, 1e-9), floor)
+    assert not work_precision.converged(points(1e-6, 1e-10, 1e-8), floor)
+    assert not work_precision.converged(points(1e-10, 1e-8, 1e-9), floor)
     # two step counts in a row without a gain, below 1e-8: round-off, stop
-    assert sweeps.converged(points(2.9e-10, 3.2e-10, 7.7e-10), floor)
+    assert work_precision.converged(points(2.9e-10, 3.2e-10, 7.7e-10), floor)
     # the same above 1e-8 is an orbit not yet followed (errors of order 1 wander): go on
-    assert not sweeps.converged(points(1.5, 1.8, 1.7), floor)
-    assert not sweeps.converged(points(1e-9, None, 1e-9), floor)  # a failed run in between
+    assert not work_precision.converged(points(1.5, 1.8, 1.7), floor)
+    assert not work_precision.converged(points(1e-9, None, 1e-9), floor)  # a failed run in between
