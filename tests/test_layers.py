@@ -57,11 +57,11 @@ def test_every_spacewar_import_points_down_and_none_is_private_or_circular():
                         "unplaced": []}
 
 
-def test_validation_has_no_cycle_and_takes_no_private_name():
-    found = import_graph.edges(ROOT, "validation")
-    assert import_graph.cycles(found) == []
-    assert import_graph.private_imports(found) == []
-    assert import_graph.private_attributes(ROOT, "validation") == []
+def test_every_validation_import_points_down_and_none_is_private_or_circular():
+    layers = declared_layers(package="validation")
+    problems = layer_violations(ROOT, "validation", layers)
+    assert problems == {"upward": [], "cycles": [], "private": [], "private_attributes": [],
+                        "unplaced": []}
 
 
 def test_the_import_linter_contracts_hold():
