@@ -14,7 +14,8 @@ core (``pytest_cmdline_main`` below: ``-n auto`` unless ``-n`` is given; ``-n 0`
   one thread with two raises the count itself (``numba.set_num_threads``).
 - **Tests that must have the machine to themselves** (``@pytest.mark.serial``: wall-clock
   budgets, hang detection, tests that start a process per core) run after all the others, on
-  one worker, while no other test runs (``SerialLastScheduling``).
+  one worker, while no other test runs; before them each worker is given a test module at a
+  time, whole, the long ones first (``ModulesThenSerial``).
 
 This file is the repository's, not the suite's rules (tests/conftest.py, which
 tests/test_skip_policy.py runs in scratch directories of its own, without this file).
@@ -158,30 +159,62 @@ def _serial_ids(directory):
     return ids
 
 
+#: the test modules that take longest (about a minute or more of a worker's time each, with a
+#: warm cache), handed out first so that none of them starts near the end while the other
+#: workers run out of tests; a module not listed starts in its turn (a stale list costs time,
+#: never a test)
+LONG_MODULES = (
+    "tests/spacewar/test_train.py",
+    "tests/engine/test_tree.py",
+    "tests/spacewar/test_untrusted_bots.py",
+    "tests/spacewar/test_untrusted_batch_bots.py",
+    "tests/engine/test_collisions.py",
+    "tests/spacewar/test_cluster.py",
+)
+
+
 @pytest.hookimpl(optionalhook=True)
 def pytest_xdist_make_scheduler(config, log):
-    """``--dist load`` (the default with ``-n``), with the serial tests run last and alone."""
+    """``--dist load`` (the default with ``-n``) becomes ``ModulesThenSerial``."""
     if config.getoption("dist") != "load":
         return None
-    return _serial_last_class()(config, log)
+    return _scheduler_class()(config, log)
 
 
-def _serial_last_class():
+def _module_order(collection, indices):
+    """``indices`` of ``collection`` (node ids) in groups, one per test module: the modules of
+    ``LONG_MODULES`` first, in its order, then the others in collection order."""
+    groups = {}
+    for i in indices:
+        groups.setdefault(collection[i].split("::", 1)[0], []).append(i)
+    rank = {name: k for k, name in enumerate(LONG_MODULES)}
+    names = sorted(groups, key=lambda name: rank.get(name, len(rank)))  # a stable sort
+    return [groups[name] for name in names]
+
+
+def _scheduler_class():
     from xdist.scheduler import LoadScheduling
 
-    class SerialLastScheduling(LoadScheduling):
-        """pytest-xdist's ``load`` scheduling of the tests that are not serial; then, once no
-        other test is left to hand out and every other worker has finished the tests it had,
-        the serial tests, all on one worker (the first to run out of work), one after another.
+    class ModulesThenSerial(LoadScheduling):
+        """A test module at a time to each worker, whole (its compiled code is compiled or
+        loaded by one worker, and its module-scoped fixtures made once), the long modules
+        first; then, once no module is left to hand out and every other worker has finished
+        its tests, the serial tests, all on one worker (the first to run out of work), one
+        after another.
 
-        (A worker runs a test when it has been given the next one, or told to stop: the worker
-        chosen for the serial tests holds its last test until they come.)"""
+        (A worker runs a test once it has been given the next one, or told to stop: a worker
+        is given its next module while it still has one test to run, and the worker chosen
+        for the serial tests holds its last test until they come.)"""
 
         def __init__(self, config, log=None):
             super().__init__(config, log)
+            self.groups = []  # modules not yet handed out: lists of indices (not serial)
             self.serial = []  # indices of the serial tests not yet handed out
             self.serial_all = frozenset()
             self.serial_node = None
+
+        def _sync(self):
+            self.pending[:] = [i for group in self.groups for i in group]
 
         @property
         def tests_finished(self):
@@ -205,22 +238,23 @@ def _serial_last_class():
             ids = _serial_ids(directory) if directory else set()
             self.serial = [i for i, nodeid in enumerate(self.collection) if nodeid in ids]
             self.serial_all = frozenset(self.serial)
-            self.pending[:] = [i for i in range(len(self.collection)) if i not in self.serial_all]
-            if self.maxschedchunk is None:
-                self.maxschedchunk = len(self.collection)
-            if self.pending:
-                # as LoadScheduling: consecutive chunks, a quarter of a worker's share each
-                chunk = max(2, min(len(self.pending) // len(self.nodes) // 4, self.maxschedchunk))
-                for node in self.nodes:
-                    self._send_tests(node, chunk)
+            self.groups = _module_order(self.collection, [
+                i for i in range(len(self.collection)) if i not in self.serial_all])
+            self._sync()
             for node in self.nodes:
                 self.check_schedule(node)
+
+        def _send(self, node, indices):
+            self.node2pending[node].extend(indices)
+            node.send_runtest_some(indices)
 
         def check_schedule(self, node, duration=0):
             if node.shutting_down:
                 return
-            if self.pending:
-                super().check_schedule(node, duration=duration)
+            if self.groups:
+                if len(self.node2pending[node]) < 2:
+                    self._send(node, self.groups.pop(0))
+                    self._sync()
                 return
             if not self.serial:
                 node.shutdown()
@@ -233,8 +267,7 @@ def _serial_last_class():
             if any(pending for other, pending in self.node2pending.items() if other is not node):
                 return  # the other workers' last tests still run
             serial, self.serial = self.serial, []
-            self.node2pending[node].extend(serial)
-            node.send_runtest_some(serial)
+            self._send(node, serial)
             node.shutdown()
 
         def mark_test_complete(self, node, item_index, duration=0):
@@ -242,6 +275,13 @@ def _serial_last_class():
             self.check_schedule(node, duration=duration)
             if self.serial_node is not None and node is not self.serial_node:
                 self.check_schedule(self.serial_node)
+
+        def mark_test_pending(self, item):
+            assert self.collection is not None
+            self.groups.insert(0, [self.collection.index(item)])
+            self._sync()
+            for node in self.nodes:
+                self.check_schedule(node)
 
         def remove_node(self, node):
             pending = self.node2pending.pop(node)
@@ -252,9 +292,12 @@ def _serial_last_class():
                 assert self.collection is not None
                 crashitem = self.collection[pending.pop(0)]
                 self.serial[:0] = [i for i in pending if i in self.serial_all]
-                self.pending.extend(i for i in pending if i not in self.serial_all)
+                rest = [i for i in pending if i not in self.serial_all]
+                if rest:
+                    self.groups.insert(0, rest)
+                    self._sync()
             for other in self.nodes:
                 self.check_schedule(other)
             return crashitem
 
-    return SerialLastScheduling
+    return ModulesThenSerial
