@@ -326,9 +326,40 @@ def _cache_classes():
         def save_overload(self, sig, data):
             self._stamped()
             _prune_legacy_once()
-            return super().save_overload(sig, data)
+            with _one_saver():
+                return super().save_overload(sig, data)
 
     return DependencyCache
+
+
+@contextlib.contextmanager
+def _one_saver():
+    """Compiled code saved by one process at a time (an exclusive lock on ``save.lock`` in
+    ``cache_dir()``). numba saves a function's code by reading its index, naming the data file
+    with the first number the index does not use, writing the data, then the index: two
+    processes saving two signatures of one function at once (the test suite's workers) could
+    both take the same number, and the index kept could name the other signature's code. A
+    process that may not lock (a confined bot: ``flock`` is refused) saves without the lock."""
+    try:
+        import fcntl
+        os.makedirs(cache_dir(), exist_ok=True)
+        lock = open(os.path.join(cache_dir(), "save.lock"), "a")
+    except (ImportError, OSError):  # not POSIX, or a directory this process may not write
+        lock = None
+    if lock is None:
+        yield
+        return
+    with lock:
+        try:
+            fcntl.flock(lock, fcntl.LOCK_EX)
+            locked = True
+        except OSError:
+            locked = False
+        try:
+            yield
+        finally:
+            if locked:
+                fcntl.flock(lock, fcntl.LOCK_UN)
 
 
 _RECORDERS = []

@@ -5,6 +5,7 @@ import of a private module or name (``engine._validate``, ``from engine.x import
 reach into a private attribute the engine's own classes define (``sim._current_model()``).
 """
 import ast
+import functools
 from pathlib import Path
 
 import pytest
@@ -18,8 +19,10 @@ def _private(name):
     return name.startswith("_") and not (name.startswith("__") and name.endswith("__"))
 
 
+@functools.lru_cache(maxsize=None)
 def _engine_private_attributes():
-    """Private attribute and method names that engine modules define (``self._x``, ``def _x``)."""
+    """Private attribute and method names that engine modules define (``self._x``, ``def _x``);
+    the engine's files parsed once for all the files checked."""
     names = set()
     for path in (ROOT / "engine").rglob("*.py"):
         for node in ast.walk(ast.parse(path.read_text())):
@@ -28,7 +31,7 @@ def _engine_private_attributes():
                 names.add(node.attr)
             elif isinstance(node, ast.FunctionDef) and _private(node.name):
                 names.add(node.name)
-    return names
+    return frozenset(names)
 
 
 def _offences(path, private_attributes):

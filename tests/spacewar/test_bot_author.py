@@ -438,6 +438,7 @@ def test_check_fails_a_bot_whose_slow_tail_lives_on_the_overage_bank(shared_dir)
                for r in report.reasons)
 
 
+@pytest.mark.serial  # the 99th percentile of its answer times, on the wall clock, under a budget
 @on_linux
 def test_warnings_do_not_fail_a_bot(shared_dir):
     """One slow answer a match (paid from the bank) and printed output that differs between

@@ -113,8 +113,9 @@ def test_a_run_is_the_same_whatever_the_batch_size_and_thread_count():
             obs, rew, term, trunc = batch.step(codes)
             out.append((obs[:3].copy(), rew[:3].copy(), term[:3].copy(), trunc[:3].copy()))
         return out
-    a = driven(3)
-    try:
+    try:  # all the threads numba may start (a test worker runs on one), then one
+        numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
+        a = driven(3)
         numba.set_num_threads(1)
         b = driven(7)
     finally:

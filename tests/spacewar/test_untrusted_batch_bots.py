@@ -207,6 +207,9 @@ def test_a_bot_that_loses_act_batch_when_made_is_a_start_up_fault():
         assert results[m]["steps"] == 0 and results[m]["forfeits"][s]
 
 
+# serial (docs/testing.md): a worker process per core of its own and confined hostile bots,
+# while the honest bot is held to a wall-clock budget
+@pytest.mark.serial
 def test_a_tournament_of_hostile_batch_bots_finishes_with_an_honest_table(capsys):
     """500 ms a frame: over 100x the p99 act time of both honest bots (measured on this 2-core
     machine while it ran other suites: sniper in this process 2.4-4.2 ms, Steady's share of a

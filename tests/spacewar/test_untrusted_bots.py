@@ -581,6 +581,9 @@ def test_inline_bot_mutating_its_observation_changes_nothing(tmp_path):
     assert ok, details
 
 
+# serial (docs/testing.md): a worker process per core of its own and seven confined bots, some
+# burning a core or memory, while the honest bot is held to a wall-clock budget
+@pytest.mark.serial
 def test_a_tournament_of_hostile_bots_finishes_with_an_honest_table(capsys):
     hostile = ["PickleBomb", "RawBytes", "EndlessLoop", "Forker", "Printer", "MemoryHog"]
     bots = [f"{HOSTILE}:{b}" for b in hostile] + ["sniper"]
