@@ -74,7 +74,7 @@ def warm_up(write=print):
     (``engine.compile_ahead.run``), holding ``warm-up.lock`` in the cache's directory: a second
     session waits for the first, then finds the tasks fresh. Returns the seconds it took."""
     from engine import cache, compile_ahead
-    from spacewar.compile_ahead import TASKS
+    from spacewar.cli.compile_tasks import TASKS
 
     start = time.perf_counter()
     base = cache.cache_base()

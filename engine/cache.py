@@ -68,7 +68,7 @@ def numpy_dot_kind():
     (``fma(a1, b1, a0 b0)``, OpenBLAS's ddot kernel on CPUs it gives FMA kernels, e.g.
     SkylakeX), ``"plain"`` (``a0 b0 + a1 b1``, e.g. its Haswell kernel on an AMD EPYC) or
     ``"other"``. Measured once on 256 fixed pairs against the exact fused value (fractions).
-    Compiled code that mirrors numpy's arithmetic (``spacewar.compiled_bots.dot_blas``)
+    Compiled code that mirrors numpy's arithmetic (``spacewar.game.compiled_bots.dot_blas``)
     is compiled for the kind found (a global that the functions reading it are keyed on)."""
     from fractions import Fraction
 

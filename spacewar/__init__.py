@@ -1,22 +1,22 @@
 """spacewar: Spacewar! (1962) on the engine, for bots: matches, tournaments, replays.
 
 ``Game`` (the compiled game), ``play_match`` (one match between two bots, see
-``spacewar.match``) and ``check_bot`` (a bot author's conformance check, see
-``spacewar.checker``) are imported on first use, so a bot's process, which needs only the
+``spacewar.arena.match``) and ``check_bot`` (a bot author's conformance check, see
+``spacewar.author.check``) are imported on first use, so a bot's process, which needs only the
 protocol, starts without loading compiled code.
 """
-from .protocol import Action, Observation, Ship, Torpedo, NOOP
-from .rules import Rules
+from spacewar.protocol import Action, Observation, Ship, Torpedo, NOOP
+from spacewar.rules import Rules
 
 __all__ = ["Action", "Observation", "Ship", "Torpedo", "NOOP", "Rules", "Game", "play_match",
            "check_bot", "CheckReport"]
 
 #: name -> (module, attribute) of the names loaded on first use
 _LAZY = {
-    "Game": (".game", "Game"),
-    "play_match": (".match", "play_match"),
-    "check_bot": (".checker", "check_bot"),
-    "CheckReport": (".checker", "CheckReport"),
+    "Game": ("spacewar.game.game", "Game"),
+    "play_match": ("spacewar.arena.match", "play_match"),
+    "check_bot": ("spacewar.author.check", "check_bot"),
+    "CheckReport": ("spacewar.author.check", "CheckReport"),
 }
 
 
@@ -25,5 +25,5 @@ def __getattr__(name):
         import importlib
 
         module, attribute = _LAZY[name]
-        return getattr(importlib.import_module(module, __name__), attribute)
+        return getattr(importlib.import_module(module), attribute)
     raise AttributeError(f"module 'spacewar' has no attribute {name!r}")

@@ -1,6 +1,6 @@
 """The built-in bots, listed once: their names, where their Python classes live, and (by
 their place in the list) their kind codes in the compiled game. ``spacewar.bots.BUILTIN``,
-``spacewar.compiled_bots.KINDS`` and ``spacewar.envs.OPPONENTS`` are made from this list.
+``spacewar.game.compiled_bots.KINDS`` and ``spacewar.learn.envs.OPPONENTS`` are made from this list.
 Pure Python: a bot's process may load it."""
 
 #: (name, module, class) of each built-in bot; the k-th is compiled kind k

@@ -10,7 +10,7 @@ Kinds (``FAULT_KINDS``, in code order: code k = 1 + the kind's index, 0 = none):
 
 Pure Python (no numba, no engine): a bot's own process may load it.
 """
-from . import wire
+from spacewar import wire
 
 FAULT_KINDS = ("raised", "invalid", "timeout", "crashed", "startup", "memory")
 

@@ -1,10 +1,10 @@
 """The trained-policy file and the bots that play it, at their documented path: the code lives
 in ``spacewar.bots.policy`` (the ``.npz`` format, its safe loading, ``Policy``, ``PolicyBot``,
-``PolicyBatch``) and ``spacewar.evaluate`` (``evaluate``); this module only re-exports them.
+``PolicyBatch``) and ``spacewar.learn.evaluate`` (``evaluate``); this module only re-exports them.
 Nothing inside ``spacewar`` imports it."""
-from .bots import policy as home
-from .bots.policy import *  # noqa: F401,F403
-from .evaluate import evaluate  # noqa: F401
+from spacewar.bots import policy as home
+from spacewar.bots.policy import *  # noqa: F401,F403
+from spacewar.learn.evaluate import evaluate  # noqa: F401
 
 __all__ = list(home.__all__) + ["evaluate"]
 

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import codes
+from spacewar import codes
 
 
 @dataclass(frozen=True)

@@ -6,7 +6,7 @@
 The drawing has two halves. ``scene(snapshot, size, ...)`` turns the plain data of one frame
 (``Game.snapshot``) into a list of backend-neutral primitives in pixel coordinates: dots,
 rings, outlined and filled polygons, lines and text. ``render_frame`` paints that list with
-Pillow; the pygame window (``spacewar.viewer``, for ``play``, ``watch`` and ``replay --view``)
+Pillow; the pygame window (``spacewar.view.window``, for ``play``, ``watch`` and ``replay --view``)
 paints the same list with pygame, so the GIF and the live game look alike.
 
 What is drawn: black space with a faint fixed star field, the central star as a flickering
@@ -27,16 +27,19 @@ blue -), also drawn beside the ship and as a ring round each torpedo.
 Pillow (and pygame for the window) are the optional ``[viz]`` extra; they are imported only
 when something is drawn.
 
-This module keeps the documented path: the code lives in ``spacewar.look`` (colours, shapes,
-durations), ``spacewar.scene`` (the primitives), ``spacewar.paint_pil`` (Pillow) and
-``spacewar.gif`` (``render_gif``); nothing inside ``spacewar`` imports this module.
+This module keeps the documented path: the code lives in ``spacewar.view.look`` (colours, shapes,
+durations), ``spacewar.view.scene`` (the primitives), ``spacewar.view.paint_pil`` (Pillow) and
+``spacewar.view.gif`` (``render_gif``); nothing inside ``spacewar`` imports this module.
 """
-from . import gif, look, paint_pil as painter, scene as scene_module
-from .gif import render_gif  # noqa: F401
-from .look import VIZ_HINT  # noqa: F401
-from .paint_pil import (PALETTE, new_image, paint_pil, palette_index, render_frame,  # noqa: F401
+from spacewar.view import gif
+from spacewar.view import look
+from spacewar.view import paint_pil as painter
+from spacewar.view import scene as scene_module
+from spacewar.view.gif import render_gif  # noqa: F401
+from spacewar.view.look import VIZ_HINT  # noqa: F401
+from spacewar.view.paint_pil import (PALETTE, new_image, paint_pil, palette_index, render_frame,  # noqa: F401
                         require_pillow)
-from .scene import Effects, footer_top, frame_snapshot, hud_bottom, scene, to_pixels  # noqa: F401
+from spacewar.view.scene import Effects, footer_top, frame_snapshot, hud_bottom, scene, to_pixels  # noqa: F401
 
 __all__ = ["Effects", "render_frame", "render_gif", "scene", "frame_snapshot", "paint_pil",
            "new_image", "palette_index", "require_pillow", "to_pixels", "footer_top",

@@ -10,7 +10,7 @@ match -> bot
   START   ``SWS1`` u32 length, then that many bytes of UTF-8 JSON (the bot's configuration)
   OBSERVE ``SWO1`` i64 frame, u32 count, then count float64 (``spacewar.protocol.raw_layout``)
   BATCH   ``SWB1`` i64 call, u32 rows, u32 width, then rows x width float32 (a batch bot's
-          learning observations, ``spacewar.features.learning_layout``, one row per match)
+          learning observations, ``spacewar.game.features.learning_layout``, one row per match)
   STOP    ``SWQ1`` i64 0, u32 0
 
 bot -> match

@@ -5,7 +5,7 @@ import points up the layer order, no cycle, no private name taken from another m
 Used by ``tests/test_layers.py`` on ``spacewar/`` and ``validation/`` (and on a small package
 made to break each rule, so the check is shown to fail when it should). What it cannot see:
 ``importlib.import_module`` with a computed name and module strings such as
-``"spacewar.bothost"``; the layer test checks the known ones by name.
+``"spacewar.sandbox.bothost"``; the layer test checks the known ones by name.
 """
 import ast
 import os

@@ -2,7 +2,10 @@
 too) points down the order declared once in pyproject.toml's ``[tool.importlinter]``; no
 module of ``spacewar`` or ``validation`` is in an import cycle or takes a private name from
 another; and the check is shown to catch each of these on a package made to break them."""
+import ast
+import importlib
 import os
+import re
 import subprocess
 import sys
 import textwrap
@@ -82,16 +85,62 @@ def test_what_a_bots_process_needs_loads_no_numba_and_no_engine():
     assert out.stdout.strip() == "[]"
 
 
-def test_module_strings_name_what_is_there():
-    # names given as strings (a bot's process, a cluster worker's warm-up) are no imports the
-    # walk sees: they must resolve where the code now lives
-    import importlib
+#: a string in the code that names a module, or a name in one: ``pkg.module`` or
+#: ``pkg.module:attribute`` (a bot's process is ``-m spacewar.sandbox.bothost``, a cluster
+#: worker's warm-up ``spacewar.arena.jobs:warm_up_game``, a compile task ``module:function``)
+MODULE_STRING = re.compile(r"^(spacewar|engine|validation)(\.[A-Za-z_]\w*)+(:[A-Za-z_]\w*)?$")
 
-    for target in ("spacewar.bothost:main", "spacewar.jobs:warm_up_game",
-                   "spacewar.tournament:warm_up_game", "spacewar.policy:Policy",
-                   "spacewar.sandbox_probe:Probe"):
-        module, name = target.split(":")
-        assert callable(getattr(importlib.import_module(module), name)), target
+
+def module_strings(root=ROOT):
+    """Every string constant of ``spacewar/``, ``validation/``, ``engine/`` and the top-level
+    conftest that is a module string, with where it is."""
+    found = []
+    paths = [os.path.join(ROOT, "conftest.py")]
+    for package in ("spacewar", "validation", "engine"):
+        for folder, _, files in os.walk(os.path.join(root, package)):
+            paths += [os.path.join(folder, f) for f in files if f.endswith(".py")]
+    for path in paths:
+        with open(path, encoding="utf-8") as f:
+            tree = ast.parse(f.read())
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Constant) and isinstance(node.value, str) \
+                    and MODULE_STRING.match(node.value):
+                found.append((node.value, f"{os.path.relpath(path, root)}:{node.lineno}"))
+    return found
+
+
+def resolves(text):
+    """Whether ``text`` (``a.b.c`` or ``a.b:c``) names a module, or a name in one."""
+    dotted = text.replace(":", ".")
+    parts = dotted.split(".")
+    for cut in range(len(parts), 0, -1):
+        try:
+            target = importlib.import_module(".".join(parts[:cut]))
+        except ImportError:
+            continue
+        try:
+            for name in parts[cut:]:
+                target = getattr(target, name)
+        except AttributeError:
+            return False
+        return True
+    return False
+
+
+def test_module_strings_name_what_is_there():
+    # names given as strings are no imports the walk sees: each must resolve where the code
+    # now lives (found in the code, so a string left behind by a move fails here)
+    strings = module_strings()
+    wanted = {"spacewar.sandbox.bothost", "spacewar.arena.jobs:warm_up_game",
+              "spacewar.sandbox.probe:Probe"}
+    assert wanted <= {text for text, _ in strings}
+    assert [(text, where) for text, where in strings if not resolves(text)] == []
+
+
+def test_a_module_string_left_behind_is_found():
+    assert resolves("spacewar.arena.jobs:warm_up_game") and resolves("spacewar.bots.chaser")
+    assert not resolves("spacewar.jobs_moved:warm_up_game")
+    assert not resolves("spacewar.arena.jobs:gone")
 
 
 # -- the check itself, on a package made to break it ----------------------------------------

@@ -30,7 +30,7 @@ import stat
 import sys
 import tokenize
 
-from ..builtin_bots import BUILTIN_BOTS
+from spacewar.builtin_bots import BUILTIN_BOTS
 
 #: name -> "module:Class" of the built-in bots (``spacewar.builtin_bots``, the one list)
 BUILTIN = {name: f"{module}:{cls}" for name, module, cls in BUILTIN_BOTS}
@@ -48,7 +48,7 @@ GEOMETRY_EXPORTS = ("wrap", "torus_delta", "torus_distance", "bearing", "angle_d
 def __getattr__(name):
     # the geometry module loads the engine (numba): only a bot that uses it pays for that
     if name in GEOMETRY_EXPORTS:
-        from . import geometry
+        from spacewar.bots import geometry
 
         return getattr(geometry, name)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
@@ -208,7 +208,7 @@ def declares_act_batch(spec):
     """Whether the class a bot specification names defines ``act_batch`` in its own body
     (a ``def`` or an assignment at the class's top level), read from its source file without
     running any of it. Such a bot from a file plays all its matches of a pairing in one
-    confined process, one call per frame (``spacewar.batch_match``); any other, one match at a
+    confined process, one call per frame (``spacewar.arena.batch_match``); any other, one match at a
     time. Only the source is read (tokenized: no parser recursion, nothing evaluated), so a
     class that gets ``act_batch`` from a base class or at run time is not seen as one; a
     file that is not a regular file, cannot be read or tokenized (the first error token
@@ -451,14 +451,14 @@ def load_bot_class(spec):
         raise BotLoadError(f"{origin!r} has no class {class_name!r}")
     if not callable(getattr(cls, "act", None)) and not callable(getattr(cls, "act_batch", None)):
         raise BotLoadError(f"{spec!r} is not a bot: it has neither act(self, obs) nor "
-                           "act_batch(self, obs) (spacewar.batch_bots)")
+                           "act_batch(self, obs) (spacewar.bots.batch)")
     return cls
 
 
 def make_bot(spec, seed=None):
     """An instance of the bot ``spec``, given ``seed`` if its constructor takes one."""
     if is_policy_file(spec):
-        from .policy import PolicyBot, PolicyError
+        from spacewar.bots.policy import PolicyBot, PolicyError
 
         try:
             return PolicyBot(spec, seed=seed)

@@ -3,8 +3,8 @@ import math
 
 import numpy as np
 
-from ..protocol import NOOP, Action
-from .geometry import (angle_diff, heading_after, lead_straight, periapsis, ram_escape,
+from spacewar.protocol import NOOP, Action
+from spacewar.bots.geometry import (angle_diff, heading_after, lead_straight, periapsis, ram_escape,
                        safe_heading_near, safest_heading, steer, torus_delta)
 
 

@@ -3,10 +3,10 @@ import math
 
 import numpy as np
 
-from ..protocol import Action
-from .geometry import (angle_diff, diamond_hits, periapsis, predict_path, star_accel, steer,
+from spacewar.protocol import Action
+from spacewar.bots.geometry import (angle_diff, diamond_hits, periapsis, predict_path, star_accel, steer,
                        wrap)
-from .sniper import Sniper
+from spacewar.bots.sniper import Sniper
 
 
 class Dodger(Sniper):

@@ -1,5 +1,5 @@
 """idle: does nothing at all. The baseline every other bot must beat."""
-from ..protocol import NOOP
+from spacewar.protocol import NOOP
 
 
 class Idle:

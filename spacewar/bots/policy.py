@@ -5,7 +5,7 @@
     codes = policy.act_batch(obs)                  # (K, D) float32 -> (K,) int64 action codes
     bot = PolicyBot("policy.npz")                  # a bot: bot.act(observation) -> Action
 
-A policy file is a NumPy ``.npz`` archive written by ``spacewar.train`` (``save_policy``): it
+A policy file is a NumPy ``.npz`` archive written by ``spacewar.learn.train`` (``save_policy``): it
 holds only numeric arrays and two texts, read here without NumPy's loader or pickle, so
 loading one runs no code from it. Its fields:
 
@@ -47,8 +47,8 @@ import zipfile
 
 import numpy as np
 
-from ..codes import codes_from_parts
-from ..strangers_files import FileRefused, read_bounded
+from spacewar.codes import codes_from_parts
+from spacewar.strangers_files import FileRefused, read_bounded
 
 FORMAT = "spacewar-policy"
 FORMAT_VERSION = 1
@@ -75,7 +75,7 @@ def layout_sha256(names):
 
 def default_inputs(rules):
     """Indices of the learning observation entries a policy reads under ``rules``."""
-    from ..features import learning_layout
+    from spacewar.game.features import learning_layout
 
     return np.array([k for k, name in enumerate(learning_layout(rules))
                      if name not in ROUND_SCALED], dtype=np.int64)
@@ -95,7 +95,7 @@ def seat_signs(rules):
     sits at the origin of the torus; a half turn keeps the sense of rotation, so turning left
     stays left). So seat 1's observation with every vector negated is an observation seat 0
     could have had, and a policy trained in seat 0 plays seat 1 from it."""
-    from ..features import learning_layout
+    from spacewar.game.features import learning_layout
 
     return np.array([-1.0 if name.rsplit(".", 1)[-1] in _VECTOR_FIELDS else 1.0
                      for name in learning_layout(rules)], dtype=np.float32)
@@ -361,8 +361,8 @@ def _meta(meta, key, kind, where, check=None, why=""):
 
 def _parse(arrays, where):
     """Validate loaded arrays; return ``(metadata, inputs, layers)`` or raise PolicyError."""
-    from ..features import learning_layout, learning_length
-    from ..rules import Rules
+    from spacewar.game.features import learning_layout, learning_length
+    from spacewar.rules import Rules
 
     fmt = _text(arrays, "format", where)
     if fmt != FORMAT:
@@ -506,7 +506,7 @@ class PolicyBot:
     """A bot playing a policy file: ``act(obs)`` for the game's ``Observation``.
 
     It rebuilds the learning observation from the raw numbers the observation carries
-    (``spacewar.features.learning_vector``), decides every ``frame_skip`` frames (the policy
+    (``spacewar.game.features.learning_vector``), decides every ``frame_skip`` frames (the policy
     was trained holding each decision that long) and holds the action in between. The
     observation does not say how many rounds the match has, so the entries scaled by it are
     computed with the training value and are not read by the network anyway. ``greedy=False``
@@ -532,8 +532,8 @@ class PolicyBot:
         self._checked = True
 
     def act(self, obs):
-        from ..features import learning_vector
-        from ..protocol import Action
+        from spacewar.game.features import learning_vector
+        from spacewar.protocol import Action
 
         if not self._checked:
             self._check_rules(obs.rules)
@@ -557,7 +557,7 @@ def check_rules(policy, rules, strict=True):
     if mine != theirs:
         diff = {k: (mine.get(k), theirs.get(k)) for k in sorted(set(mine) | set(theirs))
                 if mine.get(k) != theirs.get(k)}
-        from ..features import learning_length
+        from spacewar.game.features import learning_length
 
         if strict or learning_length(rules) != policy.observation_length:
             raise ValueError(f"the policy was trained under other rules (field: "
@@ -565,7 +565,7 @@ def check_rules(policy, rules, strict=True):
 
 
 class PolicyBatch:
-    """A policy as a batch bot (``spacewar.batch_bots``) for rows whose seats are known: each
+    """A policy as a batch bot (``spacewar.bots.batch``) for rows whose seats are known: each
     row decides every ``frame_skip`` frames and holds its action in between, seat 1's rows
     seen turned half way (``seat_signs``), greedily: row by row what ``PolicyBot`` plays in
     that row's match, however many rows are decided together. ``restart(mask)``: those rows'

@@ -1,7 +1,7 @@
 """random: presses buttons at random, from its own seeded generator (reproducible)."""
 import numpy as np
 
-from ..protocol import Action
+from spacewar.protocol import Action
 
 
 class RandomBot:

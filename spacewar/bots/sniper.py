@@ -3,8 +3,8 @@ import math
 
 import numpy as np
 
-from ..protocol import NOOP, Action
-from .geometry import (angle_diff, diamond_hits, first_hit, heading_after, launch_state,
+from spacewar.protocol import NOOP, Action
+from spacewar.bots.geometry import (angle_diff, diamond_hits, first_hit, heading_after, launch_state,
                        lead_intercept, periapsis, predict_path, safe_heading_near, safest_heading,
                        star_accel, steer, torpedo_path, torus_delta, warm_up, wrap)
 

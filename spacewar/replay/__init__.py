@@ -25,15 +25,15 @@ The code: ``spacewar.replay.format`` (fields, ``make_replay``, canonical JSON), 
 (the per-user key), ``.files`` (``save``, ``load``), ``.schema`` (``validate``), ``.simulate``
 and ``.check``; this package's names are theirs.
 """
-from ..faults import FAULT_KINDS
-from .check import check
-from .files import MAX_JSON_VALUES, load, save
-from .format import (DIGEST_FIELD, FORMAT, MAX_COUNT, MAX_FAULTS, MAX_FILE_BYTES, MAX_ROUNDS,
+from spacewar.faults import FAULT_KINDS
+from spacewar.replay.check import check
+from spacewar.replay.files import MAX_JSON_VALUES, load, save
+from spacewar.replay.format import (DIGEST_FIELD, FORMAT, MAX_COUNT, MAX_FAULTS, MAX_FILE_BYTES, MAX_ROUNDS,
                      MAX_SEED, READABLE_VERSIONS, UNCHECKED_RESULT_FIELDS, VERSION, ReplayError,
                      canonical_json, digest, make_replay)
-from .schema import validate
-from .signing import SIGNATURE_FIELD, key_path, sign, signature_status
-from .simulate import actions, fault_record, new_game, simulate
+from spacewar.replay.schema import validate
+from spacewar.replay.signing import SIGNATURE_FIELD, key_path, sign, signature_status
+from spacewar.replay.simulate import actions, fault_record, new_game, simulate
 
 __all__ = ["FORMAT", "VERSION", "FAULT_KINDS", "ReplayError", "make_replay", "save", "load",
            "validate", "check", "simulate", "actions", "fault_record", "digest",

@@ -2,13 +2,13 @@
 (the referee judging the recorded faults again), the final state compared bit for bit."""
 import math
 
-from .. import core
-from ..faults import FAULT_KINDS
-from ..referee import Referee
-from ..rules import Rules
-from .schema import validate
-from .signing import SIGNATURE_FIELD, signature_status
-from .simulate import actions, fault_record, new_game
+from spacewar.game import core
+from spacewar.faults import FAULT_KINDS
+from spacewar.game.referee import Referee
+from spacewar.rules import Rules
+from spacewar.replay.schema import validate
+from spacewar.replay.signing import SIGNATURE_FIELD, signature_status
+from spacewar.replay.simulate import actions, fault_record, new_game
 
 def _same(a, b):
     """Equal as JSON values, with bools and numbers kept apart (``True`` is not ``1``)."""

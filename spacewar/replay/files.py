@@ -5,10 +5,10 @@ import os
 
 from engine.atomic import atomic_write, check_output_path
 
-from .format import DIGEST_FIELD, MAX_FILE_BYTES, ReplayError, VERSION, canonical_json, digest
-from .schema import validate
-from .signing import SIGNATURE_FIELD, sign
-from ..strangers_files import FileRefused, read_bounded
+from spacewar.replay.format import DIGEST_FIELD, MAX_FILE_BYTES, ReplayError, VERSION, canonical_json, digest
+from spacewar.replay.schema import validate
+from spacewar.replay.signing import SIGNATURE_FIELD, sign
+from spacewar.strangers_files import FileRefused, read_bounded
 
 def save(path, replay):
     """Check ``replay``, sign it, add its content digest and write it atomically to ``path``.

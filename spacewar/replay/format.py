@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 
-from ..faults import FAULT_KINDS
+from spacewar.faults import FAULT_KINDS
 
 FORMAT = "spacewar-replay"
 VERSION = 2

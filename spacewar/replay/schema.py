@@ -5,10 +5,10 @@ import binascii
 
 import numpy as np
 
-from .. import core
-from ..faults import FAULT_KINDS
-from ..rules import Rules
-from .format import (DIGEST_FIELD, FORMAT, MAX_COUNT, MAX_FAULTS, MAX_ROUNDS, MAX_SEED,
+from spacewar.game import core
+from spacewar.faults import FAULT_KINDS
+from spacewar.rules import Rules
+from spacewar.replay.format import (DIGEST_FIELD, FORMAT, MAX_COUNT, MAX_FAULTS, MAX_ROUNDS, MAX_SEED,
                      READABLE_VERSIONS, RESULT_V1, RESULT_V2, ReplayError, TOP_V1, TOP_V2, digest)
 
 def _fail(source, message):

@@ -5,7 +5,7 @@ import hmac
 import os
 import secrets
 
-from .format import DIGEST_FIELD, ReplayError, canonical_json
+from spacewar.replay.format import DIGEST_FIELD, ReplayError, canonical_json
 
 SIGNATURE_FIELD = "signature"
 

@@ -2,9 +2,9 @@
 ``simulate``."""
 
 
-from ..game import Game
-from .format import ReplayError
-from .schema import checked_rules, decode_codes
+from spacewar.game.game import Game
+from spacewar.replay.format import ReplayError
+from spacewar.replay.schema import checked_rules, decode_codes
 
 def actions(replay):
     """The (frames, 2) array of action codes of a replay."""

@@ -5,7 +5,7 @@ Python reference bots ``names`` playing them under ``rules`` for ``frames`` fram
 frame each compiled bot decides on the same state and must choose the Python bot's action
 (``play``; ``tests/spacewar/test_compiled_bots.py`` runs the scenes).
 
-Branch coverage of ``spacewar/compiled_bots.py``: :func:`branch_table` lists the branches of
+Branch coverage of the compiled bots (``spacewar/game/compiled_bots/``): :func:`branch_table` lists the branches of
 its functions from the source (each ``if`` / ``while`` true and false, each ``for`` entered and
 left, coverage.py's notion of a branch); :func:`traced_arcs` runs code with the bots as plain
 Python (``NUMBA_DISABLE_JIT=1``, in a subprocess) under a line tracer and collects the
@@ -26,13 +26,18 @@ from pathlib import Path
 
 import numpy as np
 
-from spacewar import compiled_bots as cb, core
+from engine.cache import jit_disabled
+from spacewar.game import compiled_bots as cb
+from spacewar.game import core
 from spacewar.bots import chaser, dodger, random_bot, sniper
-from spacewar.game import Game
+from spacewar.game.game import Game
 from spacewar.rules import Rules
 
 ROOT = Path(__file__).resolve().parents[2]
-SOURCE = Path(cb.__file__).resolve()
+#: the compiled bots' modules (a package, one module per bot), each given a line-number base so
+#: that a line of any of them is one number: module k's line n is ``k * LINES + n``
+SOURCES = sorted(Path(cb.__file__).resolve().parent.glob("*.py"))
+LINES = 100_000
 PY = {"chaser": chaser.Chaser, "sniper": sniper.Sniper, "dodger": dodger.Dodger,
       "random": random_bot.RandomBot}
 
@@ -312,11 +317,19 @@ def _successor(stmt, parents):
     return _successor(owner, parents)
 
 
-def branch_table(path=SOURCE):
-    """Every branch of the module's functions: dicts with ``function``, ``line``, ``kind``
+def branch_table(paths=SOURCES):
+    """Every branch of the compiled bots' functions (line numbers on each module's base, as
+    :data:`SOURCES`): dicts with ``function``, ``line``, ``kind``
     (if / while / for), ``outcome`` (True: taken / entered, False: not / left), ``sources``
     (the lines its condition spans) and ``target`` (the line it goes to; EXIT)."""
-    tree = ast.parse(Path(path).read_text())
+    out = []
+    for base, path in enumerate(paths):
+        out.extend(_branches_of(Path(path), base * LINES))
+    return out
+
+
+def _branches_of(path, base):
+    tree = ast.parse(path.read_text())
     out = []
     for fn in tree.body:
         if not isinstance(fn, ast.FunctionDef):
@@ -341,9 +354,10 @@ def branch_table(path=SOURCE):
             kind = type(node).__name__.lower()
             other = node.orelse[0].lineno if node.orelse else _successor(node, parents)
             for outcome, target in ((True, node.body[0].lineno), (False, other)):
-                out.append({"function": fn.name, "line": node.lineno, "def": fn.lineno,
-                            "kind": kind,
-                            "outcome": outcome, "sources": sources, "target": target})
+                out.append({"function": fn.name, "line": base + node.lineno,
+                            "def": base + fn.lineno, "kind": kind, "outcome": outcome,
+                            "sources": [base + line for line in sources],
+                            "target": target if target == EXIT else base + target})
     return out
 
 
@@ -465,14 +479,15 @@ UNREACHABLE = {
 # -- tracing (in a NUMBA_DISABLE_JIT=1 process) ---------------------------------------------
 def traced_arcs(run):
     """Run ``run()`` under a line tracer; the arcs (line, next line; EXIT on return) of frames
-    of ``spacewar/compiled_bots.py``."""
+    of the compiled bots' modules, lines on each module's base (:data:`SOURCES`)."""
     arcs = set()
-    filename = str(SOURCE)
+    bases = {str(path): k * LINES for k, path in enumerate(SOURCES)}
 
     def local(frame, event, arg):
         if event == "line":
-            arcs.add((last[frame], frame.f_lineno))
-            last[frame] = frame.f_lineno
+            line = bases[frame.f_code.co_filename] + frame.f_lineno
+            arcs.add((last[frame], line))
+            last[frame] = line
         elif event == "return":
             arcs.add((last.pop(frame, 0), EXIT))
         return local
@@ -480,8 +495,8 @@ def traced_arcs(run):
     last = {}
 
     def world(frame, event, arg):
-        if event == "call" and frame.f_code.co_filename == filename:
-            last[frame] = frame.f_code.co_firstlineno
+        if event == "call" and frame.f_code.co_filename in bases:
+            last[frame] = bases[frame.f_code.co_filename] + frame.f_code.co_firstlineno
             return local
         return None
 
@@ -497,7 +512,7 @@ def _replay(states_path, out_path):
     """Subprocess side: decide on every recorded state with the bots as plain Python, traced;
     check each decision is the recorded compiled one; write the arcs and, per arc, the first
     state reaching it."""
-    if not cb.jit_disabled():
+    if not jit_disabled():
         raise SystemExit("run with NUMBA_DISABLE_JIT=1")
     data = np.load(states_path, allow_pickle=False)
     meta = json.loads(str(data["meta"]))

@@ -17,7 +17,7 @@ def gymnasium(optional):
 
 @pytest.fixture(scope="module")
 def envs(gymnasium):
-    """spacewar.envs (importing it registers Spacewar-v0)."""
-    import spacewar.envs
+    """spacewar.learn.envs (importing it registers Spacewar-v0)."""
+    import spacewar.learn.envs
 
-    return spacewar.envs
+    return spacewar.learn.envs

@@ -3,7 +3,7 @@ any worker says so and is held until released, so that the test kills a worker t
 certainly running a task (no timed poll of the scheduler).
 
 Its ``setup`` runs in each worker process (a restarted one too) and wraps
-``spacewar.cluster_play.play_chunk``, which the client's tasks name by reference. The first call
+``spacewar.arena.cluster.play_chunk``, which the client's tasks name by reference. The first call
 across the cluster claims ``claimed`` (an exclusive create), writes ``started`` (its process id
 and the task's fingerprint) and waits for ``release``; every call that returns appends its
 fingerprint and process id to ``done``."""
@@ -48,7 +48,7 @@ class HoldFirstTask(WorkerPlugin):
         self.hold_limit = hold_limit
 
     def setup(self, worker):
-        from spacewar import cluster_play
+        from spacewar.arena import cluster as cluster_play
 
         self.original = original = cluster_play.play_chunk
         directory, hold_limit = self.directory, self.hold_limit
@@ -73,6 +73,6 @@ class HoldFirstTask(WorkerPlugin):
         cluster_play.play_chunk = play_chunk
 
     def teardown(self, worker):
-        from spacewar import cluster_play
+        from spacewar.arena import cluster as cluster_play
 
         cluster_play.play_chunk = self.original

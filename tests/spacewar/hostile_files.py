@@ -161,7 +161,7 @@ def bzip2_policy(path):
 def policy_parts(rules=None, hidden=16, seed=0):
     """``(arrays, metadata)`` of a legal two-layer policy under ``rules`` (default: the
     1962 rules) with ``hidden`` units, small random weights."""
-    from spacewar.learning import learning_layout, learning_length
+    from spacewar.learn.batch import learning_layout, learning_length
     from spacewar.policy import ACTION_FORMAT, FORMAT_VERSION, NVEC, default_inputs, \
         layout_sha256
     from spacewar.rules import Rules

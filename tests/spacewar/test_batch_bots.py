@@ -9,11 +9,11 @@ import pytest
 
 from spacewar import Rules
 from spacewar.codes import NOOP
-from spacewar.batch_bots import SingleFromBatch, ask_batch, checked_codes
-from spacewar.batch_match import play_matches
-from spacewar.learning import learning_layout
-from spacewar.match import play_match
-from spacewar.seats import Limits
+from spacewar.bots.batch import SingleFromBatch, ask_batch, checked_codes
+from spacewar.arena.batch_match import play_matches
+from spacewar.learn.batch import learning_layout
+from spacewar.arena.match import play_match
+from spacewar.sandbox.limits import Limits
 from spacewar.wire import INVALID, OK, RAISED
 
 SHORT = Rules(max_round_frames=400, post_round_delay=8)
@@ -126,7 +126,7 @@ def test_checked_codes_take_only_k_valid_integers():
 
 def test_one_match_asks_a_batch_bot_with_one_row():
     from spacewar import Game
-    from spacewar.learning import learning_vector
+    from spacewar.learn.batch import learning_vector
 
     game = Game(SHORT, seeds=[4], rounds=2)
     for _ in range(50):
@@ -176,7 +176,7 @@ def test_only_bots_that_can_share_a_game_are_played_together(tmp_path):
 def policy_file(tmp_path_factory, optional):
     optional("jax")
     optional("optax")
-    from spacewar import train
+    from spacewar.learn import train
 
     config = train.TrainConfig(seed=3)
     path = str(tmp_path_factory.mktemp("policy") / "policy.npz")
@@ -207,7 +207,7 @@ def test_a_policy_file_is_the_envs_opponent_as_its_bot_would_play(policy_file, t
     optional("gymnasium")
     import shutil
 
-    from spacewar import envs
+    from spacewar.learn import envs
     from spacewar.policy import PolicyBot
     from spacewar.protocol import action_code
 

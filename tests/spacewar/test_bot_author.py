@@ -21,11 +21,13 @@ from spacewar import NOOP, Action, Game, Rules
 from spacewar.bots import BotLoadError, locate, make_bot
 from spacewar.bots import geometry
 from spacewar.bots.geometry import angle_diff, heading_after, launch_state, torus_delta, wrap
-from spacewar.checker import check_bot, play_fingerprint
+from spacewar.author.check import check_bot, play_fingerprint
 from spacewar.cli import main
-from spacewar.match import act_time_summary, play_match
-from spacewar.seats import Limits, ProcessSeat, open_seat
-from spacewar.starter import class_name_for, starter_source, write_starter
+from spacewar.arena.match import act_time_summary, play_match
+from spacewar.sandbox.limits import Limits
+from spacewar.sandbox.process import ProcessSeat
+from spacewar.arena.seats import open_seat
+from spacewar.author.new_bot import class_name_for, starter_source, write_starter
 
 # budgets long enough that an honest answer is never late on a loaded machine: these tests
 # assert what a bot does, not how fast the machine is

@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 
 from engine.analytic import kepler, orbital_elements
-from spacewar import Action, Game, Rules, core
+from spacewar import Action, Game, Rules
+from spacewar.game import core
 from spacewar.bots import make_bot
 from spacewar.bots.chaser import Chaser
 from spacewar.bots.dodger import Dodger
@@ -14,7 +15,7 @@ from spacewar.bots.geometry import (first_hit, launch_state, lead_intercept, lea
                                     safest_heading, steer, torus_delta)
 from spacewar.bots.idle import Idle
 from spacewar.bots.sniper import Sniper
-from spacewar.match import play_match
+from spacewar.arena.match import play_match
 
 SMART = ("chaser", "sniper", "dodger")
 

@@ -1,4 +1,4 @@
-"""Tournaments on a Dask cluster (``spacewar.cluster_play``, ``engine.cluster``): the same JSON
+"""Tournaments on a Dask cluster (``spacewar.arena.cluster``, ``engine.cluster``): the same JSON
 as local processes, bots from files (hostile ones included) sent as bytes, a worker killed
 mid-run changing nothing, a worker with other code refused; a league and a validation sweep on
 the cluster giving the local results."""
@@ -11,9 +11,9 @@ from pathlib import Path
 import pytest
 
 from engine import cluster
-from spacewar import cluster_play
+from spacewar.arena import cluster as cluster_play
 from spacewar.bots import BotLoadError
-from spacewar.tournament import run_tournament
+from spacewar.arena.tournament import run_tournament
 
 from . import held_task
 
@@ -27,7 +27,7 @@ def distributed(optional):
 
 @pytest.fixture(scope="module")
 def dask_cluster(distributed):
-    cluster.warm_up(["spacewar.jobs:warm_up_game"])  # the workers then only load
+    cluster.warm_up(["spacewar.arena.jobs:warm_up_game"])  # the workers then only load
     with distributed.LocalCluster(n_workers=2, processes=True, threads_per_worker=1,
                                   dashboard_address=":0") as local:
         yield local
@@ -131,7 +131,7 @@ def test_chunks_keep_the_order_and_bound_their_size():
 
 
 def test_a_league_on_the_cluster_writes_the_local_file_byte_for_byte(dask_cluster, tmp_path):
-    from spacewar.league import run_league
+    from spacewar.arena.league import run_league
 
     bots = ["chaser", "sniper", "dodger", "random", f"{HOSTILE}:ExitInAct"]
     quick = dict(games=1, match_rounds=1, progress=False, bootstrap=20)

@@ -1,4 +1,4 @@
-"""The compiled bots (spacewar.compiled_bots) against the Python reference bots.
+"""The compiled bots (spacewar.game.compiled_bots) against the Python reference bots.
 
 Agreement: seeded scenes of matches (``compiled_bot_scenes.SCENES``), their ships scattered at
 random positions, velocities, headings, fuel and magazines so that the frames cover the bots'
@@ -19,9 +19,10 @@ import numpy as np
 import pytest
 
 from engine.cache import numpy_dot_kind
-from spacewar import compiled_bots as cb, core
+from spacewar.game import compiled_bots as cb
+from spacewar.game import core
 from spacewar.bots import chaser, dodger, sniper
-from spacewar.game import Game
+from spacewar.game.game import Game
 from spacewar.rules import Rules
 from tests.spacewar.compiled_bot_scenes import (SCENES, Disagreement, arrays, check_frame, play,
                                                  scatter)
@@ -34,7 +35,7 @@ def _never_rams(dx, dy, wx, wy, distance, horizon):
 def chaser_without_ram_dodge():
     """A planted bug: the compiled chaser compiled again with ``ram_escape`` never firing (it
     never dodges a ram), as ``decide_all`` for the chaser's kind."""
-    plain = cb.chaser.py_func
+    plain = cb.chaser.chaser.py_func
     variant = numba.njit(error_model="numpy")(types.FunctionType(
         plain.__code__, {**plain.__globals__, "ram_escape": _never_rams}, "chaser_no_ram"))
 

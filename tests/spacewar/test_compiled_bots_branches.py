@@ -2,7 +2,7 @@
 
 The scenes of ``compiled_bot_scenes.SCENES`` are played by test_compiled_bots.py, every frame
 compared. Here the branch coverage they give is held: the bots' source
-(``spacewar/compiled_bots.py``) run as plain Python (``NUMBA_DISABLE_JIT=1``, a subprocess)
+(``spacewar/game/compiled_bots/``, one module per bot) run as plain Python (``NUMBA_DISABLE_JIT=1``, a subprocess)
 under a line tracer, on states of those scenes, must take each ``if`` / ``while`` both ways and
 enter and leave each ``for`` (``branch_table``), but for the ``UNREACHABLE`` list (each with its
 reason). Each traced decision must also be the compiled code's, on the same state.

@@ -235,7 +235,7 @@ def test_a_reset_mask_under_next_step_autoreset_restarts_only_the_masked_matches
 
 
 def test_more_matches_than_chunks_give_the_same_games():
-    from spacewar.learning import CHUNKS, LearningBatch
+    from spacewar.learn.batch import CHUNKS, LearningBatch
 
     few = LearningBatch(12, seed=6, frame_cap=500, opponents=("chaser", "sniper"))
     many = LearningBatch(CHUNKS + 44, seed=6, frame_cap=500, opponents=("chaser", "sniper"))

@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from spacewar.bots.idle import Idle
-from spacewar.learning import learning_length
+from spacewar.learn.batch import learning_length
 from spacewar.rules import Rules
 
 

@@ -14,8 +14,8 @@ import pytest
 from engine import cluster
 from spacewar.bots import BotLoadError
 from spacewar.cli import main
-from spacewar.league import run_league
-from spacewar.tournament import run_tournament
+from spacewar.arena.league import run_league
+from spacewar.arena.tournament import run_tournament
 
 #: the twins' bot: turns, thrusts and fires, which beats a bot that does nothing
 TWIN = b'''from spacewar import Action
@@ -60,7 +60,7 @@ def worker_tmp(tmp_path_factory):
 @pytest.fixture(scope="module")
 def dask_cluster(worker_tmp, optional):
     distributed = optional("distributed")
-    cluster.warm_up(["spacewar.jobs:warm_up_game"])  # the workers then only load
+    cluster.warm_up(["spacewar.arena.jobs:warm_up_game"])  # the workers then only load
     saved = os.environ.get("TMPDIR")
     os.environ["TMPDIR"] = str(worker_tmp)  # the workers' tempfile.gettempdir()
     try:
@@ -136,7 +136,7 @@ def test_a_bot_planted_where_a_worker_looked_never_plays_and_no_copy_is_left(
 
 
 def test_a_tasks_copies_are_private_and_removed_even_on_error(tmp_path):
-    from spacewar import cluster_play
+    from spacewar.arena import cluster as cluster_play
 
     twins = _twins(tmp_path)
     files = cluster_play.bot_files(twins)
@@ -156,7 +156,7 @@ def test_a_tasks_copies_are_private_and_removed_even_on_error(tmp_path):
 
 
 def test_bytes_that_do_not_match_their_hash_are_refused(tmp_path):
-    from spacewar import cluster_play
+    from spacewar.arena import cluster as cluster_play
 
     files = {"x/bot.py:Bot": ("bot.py", b"print('other code')", "0" * 64)}
     with pytest.raises(ValueError, match="do not match its sha256"):
@@ -289,7 +289,7 @@ def test_directories_left_by_a_killed_process_are_swept_and_a_live_ones_kept(tmp
     """A seat's and a cluster task's directories are named after their process: one whose
     process is gone (killed by SIGKILL, it cleaned nothing up) is removed by the next one,
     a live process's is kept."""
-    from spacewar.seats import sweep_stale_directories
+    from spacewar.sandbox.provision import sweep_stale_directories
 
     monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
     gone = subprocess.Popen([sys.executable, "-c", "pass"])

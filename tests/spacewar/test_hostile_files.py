@@ -54,7 +54,7 @@ print(json.dumps(report))
 """
 
 
-def load_in_child(path, loader="spacewar.policy:Policy.load", preload=("spacewar.learning",)):
+def load_in_child(path, loader="spacewar.policy:Policy.load", preload=("spacewar.learn.batch",)):
     """What ``loader(path)`` did in a child under ``CHILD_LIMIT`` (``preload``: modules
     imported before the limit): a dict with the exception's name (``error``, None if it
     loaded), its ``message``, whether a MemoryError was behind it and the peak resident
@@ -166,7 +166,7 @@ def test_a_replay_of_many_tiny_json_values_is_refused_before_it_is_parsed(tmp_pa
 @pytest.fixture(scope="module")
 def recorded(tmp_path_factory):
     """A short match's replay (built-in bots, in this process)."""
-    from spacewar.match import play_match
+    from spacewar.arena.match import play_match
 
     _, rep, _ = play_match("idle", "random", seed=2, rounds=1, record=True)
     path = tmp_path_factory.mktemp("replay") / "game.json"

@@ -1,4 +1,4 @@
-"""Hostile league results files (``spacewar.league``): a resume checks every stored round and
+"""Hostile league results files (``spacewar.arena.league``): a resume checks every stored round and
 match before it uses any of them, and trusts only a file signed with this user's key. Every
 forgery is a LeagueFileError naming the file, the round, the match and the field, never a
 traceback; a file that is not verified resumes only when asked to, and then says so."""
@@ -11,7 +11,8 @@ import textwrap
 
 import pytest
 
-from spacewar import league, replay
+from spacewar import replay
+from spacewar.arena import league, league_file
 
 BOTS = ["idle", "random"]
 ROUNDS = 2
@@ -253,10 +254,10 @@ def test_a_file_larger_than_its_league_can_be_is_refused_unread(tmp_path, legit)
         f.write('{"format": "spacewar-league", "version": 1, "rounds": [')
         f.write("[]," * (20 << 20))
         f.write("[]]}")
-    assert league.max_file_bytes(config, ROUNDS) < os.path.getsize(path) // 20
+    assert league_file.max_file_bytes(config, ROUNDS) < os.path.getsize(path) // 20
     child = textwrap.dedent(f"""
         import json, resource, sys
-        from spacewar import league
+        from spacewar.arena import league
 
         def status(field):
             return int(next(line.split()[1] for line in open("/proc/self/status")

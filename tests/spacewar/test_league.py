@@ -1,4 +1,4 @@
-"""Leagues (``spacewar.league``): pairings, ratings with uncertainty, and resuming from the
+"""Leagues (``spacewar.arena.league``): pairings, ratings with uncertainty, and resuming from the
 results file after an interruption with the same end as a run straight through."""
 import json
 import os
@@ -7,11 +7,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from spacewar import league
+from spacewar.arena import league, ratings
 from spacewar.bots import bots_in
 from spacewar.rules import Rules
-from spacewar.seats import Limits
-from spacewar.tournament import bradley_terry_elo
+from spacewar.sandbox.limits import Limits
+from spacewar.arena.ratings import bradley_terry_elo
 
 BOTS = ["chaser", "sniper", "dodger", "random", "idle"]  # odd: a bye every round
 QUICK = dict(games=1, match_rounds=1, workers=1, progress=False, bootstrap=40)
@@ -55,13 +55,13 @@ def test_the_sparse_bradley_terry_fit_is_the_tournaments():
         a, b = rng.choice(6, 2, replace=False)
         winner = [None, bots[a], bots[b]][rng.integers(3)]
         matches.append({"p1": bots[a], "p2": bots[b], "winner": winner})
-    sparse = league.bradley_terry_intervals(bots, matches, 200, seed=1)
-    dense = bradley_terry_elo(bots, [(m["p1"], m["p2"], league._outcome(m)) for m in matches])
+    sparse = ratings.bradley_terry_intervals(bots, matches, 200, np.random.default_rng(1))
+    dense = bradley_terry_elo(bots, [(m["p1"], m["p2"], ratings.match_outcome(m)) for m in matches])
     for b in bots:
         elo, low, high = sparse[b]
         assert elo == pytest.approx(dense[b], abs=1e-9)
         assert low < elo < high  # every bot has a non-degenerate interval around its fit
-    assert league.bradley_terry_intervals(bots, matches, 200, seed=1) == sparse  # seeded
+    assert ratings.bradley_terry_intervals(bots, matches, 200, np.random.default_rng(1)) == sparse  # seeded
 
 
 def test_a_league_resumed_after_interruptions_ends_as_one_run_straight_through(tmp_path):

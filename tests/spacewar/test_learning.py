@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from spacewar import Game, Rules
-from spacewar.learning import learning_layout, learning_length, torpedo_slots
+from spacewar.learn.batch import learning_layout, learning_length, torpedo_slots
 
 
 def _played(rules, matches=6, frames=400, seed=3):
@@ -98,7 +98,7 @@ def test_out_is_checked_and_written_in_place():
 def test_a_run_is_the_same_whatever_the_batch_size_and_thread_count():
     import numba
 
-    from spacewar.learning import LearningBatch
+    from spacewar.learn.batch import LearningBatch
 
     threads = numba.get_num_threads()
 
@@ -127,7 +127,7 @@ def test_a_run_is_the_same_whatever_the_batch_size_and_thread_count():
 
 
 def test_rewards_follow_the_score_and_episodes_restart_the_step_after_they_end():
-    from spacewar.learning import LearningBatch, learning_layout
+    from spacewar.learn.batch import LearningBatch, learning_layout
 
     batch = LearningBatch(4, seed=3, rounds=2)
     names = learning_layout(batch.rules)
@@ -169,7 +169,7 @@ def test_rewards_follow_the_score_and_episodes_restart_the_step_after_they_end()
 
 
 def test_bad_frame_cap_is_refused():
-    from spacewar.learning import LearningBatch
+    from spacewar.learn.batch import LearningBatch
 
     with pytest.raises(ValueError, match="frame_cap must be an int >= 0, got -1"):
         LearningBatch(2, frame_cap=-1)

@@ -7,8 +7,8 @@ import pytest
 
 from spacewar import replay
 from spacewar.bots import BotLoadError, available, load_bot_class
-from spacewar.match import play_match
-from spacewar.seats import Limits
+from spacewar.arena.match import play_match
+from spacewar.sandbox.limits import Limits
 
 HERE = os.path.dirname(__file__)
 TEST_BOTS = "tests.spacewar.bots_for_tests"

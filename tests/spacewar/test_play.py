@@ -1,4 +1,4 @@
-"""Tests for spacewar.play: people and bots in the window, run headless with scripted keys.
+"""Tests for spacewar.view.live: people and bots in the window, run headless with scripted keys.
 
 No test here reads the wall clock: the window's pace is driven by a fake clock that moves
 only when a picture is drawn (``FakeWallClock``), so how many window ticks (and so game frames)
@@ -16,15 +16,15 @@ os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
 import pytest  # noqa: E402
 
 from engine.clock import FixedStepClock  # noqa: E402
-from spacewar import keys as K  # noqa: E402
-from spacewar import play as play_module  # noqa: E402
+from spacewar.view import keys as K  # noqa: E402
+from spacewar.view import live as play_module  # noqa: E402
 from spacewar import replay as replay_io  # noqa: E402
-from spacewar import viewer  # noqa: E402
-from spacewar.match import play_match  # noqa: E402
-from spacewar.play import format_summary, held_keys_code, play, play_script_source, watch  # noqa: E402
+from spacewar.view import window as viewer  # noqa: E402
+from spacewar.arena.match import play_match  # noqa: E402
+from spacewar.view.live import format_summary, held_keys_code, play, play_script_source, watch  # noqa: E402
 from spacewar.protocol import Action  # noqa: E402
 from spacewar.rules import Rules  # noqa: E402
-from spacewar.seats import Limits  # noqa: E402
+from spacewar.sandbox.limits import Limits  # noqa: E402
 
 # A confined bot's budget here: an action of a test bot in its own process took 0.13-0.19 ms
 # at the median and 3.8-5.3 ms at the 99th percentile (measured on this 2-core machine while
@@ -49,7 +49,7 @@ class FakeWallClock:
 
 @contextlib.contextmanager
 def fake_window_clock(draw_rate=30):
-    """Drive ``spacewar.play``'s window with a ``FakeWallClock``: its pace (``viewer.Pace``'s
+    """Drive ``spacewar.view.live``'s window with a ``FakeWallClock``: its pace (``viewer.Pace``'s
     wall clock, an ``engine.clock.FixedStepClock`` given the fake clock) and ``run_window``'s
     ``max_seconds`` and ``wall_seconds`` read it, and every ``Window.show`` advances it."""
     clock = FakeWallClock(draw_rate)
@@ -366,7 +366,8 @@ def test_the_summary_is_a_table(watched):
 
 
 def test_a_bot_from_elsewhere_plays_confined_exactly_as_in_a_match(pygame, monkeypatch):
-    from spacewar.seats import InlineSeat, ProcessSeat
+    from spacewar.arena.seats import InlineSeat
+    from spacewar.sandbox.process import ProcessSeat
 
     opened = []
     real_open = play_module.open_seat
@@ -478,7 +479,7 @@ def test_help_lists_the_keys_and_the_defaults(capsys):
 
 
 def test_watch_from_the_command_line_to_the_end(pygame, tmp_path, monkeypatch, capsys):
-    from spacewar import viewer
+    from spacewar.view import window as viewer
     from spacewar.cli import main
 
     real_poll = viewer.Window.poll

@@ -9,7 +9,7 @@ import zipfile
 import numpy as np
 import pytest
 
-from spacewar.batch_bots import checked_codes
+from spacewar.bots.batch import checked_codes
 from spacewar.policy import Policy, PolicyError
 
 

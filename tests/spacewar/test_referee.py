@@ -1,4 +1,4 @@
-"""One referee (``spacewar.referee``) judges every frame of every match: a single match, the
+"""One referee (``spacewar.game.referee``) judges every frame of every match: a single match, the
 rows of a batch, the window's live match and the replay check. Its rules on their own, and a
 check that no other module keeps its own copy of them."""
 import ast
@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from spacewar.faults import FAULT_KINDS
-from spacewar.referee import Referee
+from spacewar.game.referee import Referee
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
@@ -68,7 +68,7 @@ def test_a_seat_that_cannot_start_forfeits_before_any_frame():
 
 @pytest.mark.parametrize("name", ["FaultLog", "fault_code", "step_one_codes"])
 def test_no_module_keeps_its_own_copy_of_the_referee(name):
-    # the referee's rules live in spacewar/referee.py: no other module builds a fault log,
+    # the referee's rules live in spacewar/game/referee.py: no other module builds a fault log,
     # codes a fault for a replay or steps one match a frame (a copy of the loop would)
     users = []
     for folder, _, files in os.walk(os.path.join(ROOT, "spacewar")):
@@ -85,4 +85,4 @@ def test_no_module_keeps_its_own_copy_of_the_referee(name):
                               else getattr(func, "id", None))
                     if called == name:
                         users.append(os.path.relpath(path, ROOT))
-    assert set(users) == {"spacewar/referee.py"}, users
+    assert set(users) == {"spacewar/game/referee.py"}, users

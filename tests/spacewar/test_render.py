@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 from spacewar import render
-from spacewar.game import Game
-from spacewar.match import play_match
+from spacewar.game.game import Game
+from spacewar.arena.match import play_match
 from spacewar.render import Effects, render_frame, render_gif
 from spacewar.replay import save
 from spacewar.rules import Rules
@@ -117,7 +117,7 @@ def test_a_crash_mid_render_leaves_no_partial_file(tmp_path, replay, monkeypatch
     out = tmp_path / "keep.gif"
     out.write_bytes(b"GIF89a the previous file")  # a GIF may be replaced by a new GIF
     calls = {"n": 0}
-    from spacewar import gif
+    from spacewar.view import gif
 
     real = gif.render_frame
 

@@ -6,7 +6,7 @@ import os
 import pytest
 
 from spacewar import replay
-from spacewar.match import play_match
+from spacewar.arena.match import play_match
 
 TEST_BOTS = "tests.spacewar.bots_for_tests"
 
@@ -235,7 +235,7 @@ def test_make_replay_positional_arguments_still_work(clean):
 
 
 def test_fault_codes_follow_the_seats_kinds():
-    from spacewar.seats import FAULT_KINDS
+    from spacewar.faults import FAULT_KINDS
 
     assert replay.FAULT_KINDS == FAULT_KINDS == (
         "raised", "invalid", "timeout", "crashed", "startup", "memory")
@@ -426,7 +426,7 @@ def _as_version_1(rep):
 def test_a_result_forged_under_version_1_is_rejected():
     """A version 1 file carries no fault record and no digest: relabelling an edited replay as
     version 1 must not make its forged forfeit pass."""
-    from spacewar.match import play_match
+    from spacewar.arena.match import play_match
 
     result, rep, _ = play_match("chaser", "random", seed=9, rounds=1, record=True)
     honest = _as_version_1(rep)
@@ -448,7 +448,7 @@ def test_a_result_forged_under_version_1_is_rejected():
 def test_a_faulted_frame_must_have_played_the_no_op():
     import base64
 
-    from spacewar.match import play_match
+    from spacewar.arena.match import play_match
 
     _, rep, _ = play_match("tests.spacewar.bots_for_tests:Raising", "chaser", seed=1, rounds=1,
                            max_faults=3, record=True)
@@ -465,7 +465,7 @@ def test_signed_replays_detect_a_forger_who_recomputes_the_digest(tmp_path, repl
     user's key: swapping the bots' names, or forging a fault record, is caught."""
     import json as _json
 
-    from spacewar.match import play_match
+    from spacewar.arena.match import play_match
 
     result, rep, _ = play_match("idle", "sniper", seed=3, rounds=1, record=True)
     path = tmp_path / "r.json"
@@ -487,7 +487,7 @@ def test_signed_replays_detect_a_forger_who_recomputes_the_digest(tmp_path, repl
 
 def test_a_replay_signed_elsewhere_is_reported_as_unverifiable(tmp_path, monkeypatch, capsys):
     from spacewar.cli import main
-    from spacewar.match import play_match
+    from spacewar.arena.match import play_match
 
     _, rep, _ = play_match("chaser", "random", seed=2, rounds=1, record=True)
     path = tmp_path / "r.json"

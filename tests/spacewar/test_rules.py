@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from spacewar import Action, Game, Rules
-from spacewar import core
+from spacewar.game import core
 
 NOOP = core.NOOP
 THRUST = Action(thrust=True).code()

@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from spacewar.cli import main
-from spacewar.tournament import bradley_terry_elo, run_tournament, schedule
+from spacewar.arena.ratings import bradley_terry_elo
+from spacewar.arena.tournament import run_tournament, schedule
 
 
 def test_schedule_both_seat_orders_same_seeds():
@@ -29,7 +30,7 @@ def test_elo_orders_by_strength_and_is_finite_for_perfect_records():
 
 # -- the ratings' values against an independent Bradley-Terry fit ------------------------------
 def newton_bradley_terry(names, results):
-    """The maximum-likelihood fit of spacewar.tournament's model, by Newton's method on the
+    """The maximum-likelihood fit of spacewar.arena.tournament's model, by Newton's method on the
     log-strengths (not the project's MM iteration): P(i beats j) = s_i / (s_i + s_j), each bot
     one virtual draw against an anchor of strength 1, ratings 1500 + 400 log10(s)."""
     k = len(names)
@@ -199,10 +200,10 @@ def test_cli_numbers_are_checked(capsys, option, value, message):
 
 
 def test_cli_bad_replay_path_fails_before_the_match(capsys, monkeypatch, tmp_path):
-    import spacewar.match
+    import spacewar.arena.match
 
     played = []
-    monkeypatch.setattr(spacewar.match, "play_match", lambda *a, **k: played.append(1))
+    monkeypatch.setattr(spacewar.arena.match, "play_match", lambda *a, **k: played.append(1))
     assert main(["match", "--p1", "idle", "--p2", "idle", "--replay",
                  str(tmp_path / "missing" / "r.json")]) == 2
     assert "does not exist" in capsys.readouterr().err and played == []

@@ -23,10 +23,10 @@ SHORT = dict(opponent="random", minutes=30.0, steps=20_000_000, seed=2, envs=512
 
 @pytest.fixture(scope="module")
 def train_mod(optional):
-    """spacewar.train, once its optional packages (the [rl] extra) are there."""
+    """spacewar.learn.train, once its optional packages (the [rl] extra) are there."""
     for name in ("gymnasium", "jax", "optax"):
         optional(name)
-    from spacewar import train
+    from spacewar.learn import train
 
     return train
 
@@ -63,7 +63,7 @@ def test_a_short_run_learns_to_win_where_the_untrained_policy_does_not(trained, 
 
 def test_the_policy_bot_wins_real_matches_in_either_seat(trained):
     """play_match with the Python bot: the bot adapter, its frame skip and its seat-1 view."""
-    from spacewar.match import play_match
+    from spacewar.arena.match import play_match
 
     out, _ = trained
     wins = 0
@@ -265,7 +265,7 @@ def test_a_policy_file_plays_as_a_bot_spec_and_a_bad_one_is_refused(tmp_path, un
 
 
 def test_the_policy_bot_refuses_other_rules(untrained):
-    from spacewar.game import Game
+    from spacewar.game.game import Game
 
     game = Game(Rules(star="light"), seeds=[0], rounds=1)
     bot = PolicyBot(untrained)
@@ -276,8 +276,8 @@ def test_the_policy_bot_refuses_other_rules(untrained):
 def test_the_bot_computes_the_envs_observation(untrained, optional):
     """What a bot computes from its Observation is what the env showed in training."""
     optional("gymnasium")
-    from spacewar.envs import SpacewarVectorEnv
-    from spacewar.learning import learning_vector
+    from spacewar.learn.envs import SpacewarVectorEnv
+    from spacewar.learn.batch import learning_vector
 
     env = SpacewarVectorEnv(2, opponent="random", rounds=1)
     obs, _ = env.reset(seed=4)
@@ -290,7 +290,7 @@ def test_the_bot_computes_the_envs_observation(untrained, optional):
 
 
 def test_seat_one_turned_half_way_is_seat_zero_at_the_start():
-    from spacewar.game import Game
+    from spacewar.game.game import Game
     from spacewar.policy import seat_signs
 
     game = Game(Rules(), seeds=[3], rounds=1)

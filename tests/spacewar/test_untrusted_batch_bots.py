@@ -8,13 +8,13 @@ import numpy as np
 import pytest
 
 from spacewar import Rules
-from spacewar.batch_match import batch_seed, play_matches
-from spacewar.checker import check_bot
+from spacewar.arena.batch_match import batch_seed, play_matches
+from spacewar.author.check import check_bot
 from spacewar.cli import main
-from spacewar.match import play_match
-from spacewar.seats import Limits
-from spacewar.tournament import batch_files_of, group_jobs, make_jobs, run_tournament, schedule
-from spacewar.jobs import play_job as tournament_play
+from spacewar.arena.match import play_match
+from spacewar.sandbox.limits import Limits
+from spacewar.arena.tournament import batch_files_of, group_jobs, make_jobs, run_tournament, schedule
+from spacewar.arena.jobs import play_job as tournament_play
 
 from . import hostile_batch_bots  # the same classes, played as objects
 from .test_untrusted_bots import FAST, LONG, ROOMY, SHORT, nothing_left_running  # noqa: F401

@@ -17,9 +17,9 @@ import pytest
 
 from spacewar import Rules
 from spacewar.cli import main
-from spacewar.match import play_match
-from spacewar.seats import Limits
-from spacewar.tournament import run_tournament
+from spacewar.arena.match import play_match
+from spacewar.sandbox.limits import Limits
+from spacewar.arena.tournament import run_tournament
 
 HOSTILE = "tests.spacewar.hostile_bots"
 SHORT = Rules(max_round_frames=400, post_round_delay=8)  # a drawn round ends soon
@@ -117,7 +117,7 @@ def test_cheats_do_not_change_the_result(bot, baseline):
 
 def test_import_time_patch_of_the_match_does_not_rig_a_tournament(tmp_path):
     rigger = write_bot(tmp_path, """
-        import spacewar.match as m
+        import spacewar.arena.match as m
         def rigged(game, bots, *args, **kw):
             return {"winner": bots[0], "score": [9, 0]}
         m.match_result = rigged
@@ -271,7 +271,7 @@ def test_killing_the_match_process_kills_the_bot(bot):
     gone."""
     import select
 
-    code = ("from spacewar.match import play_match\n"
+    code = ("from spacewar.arena.match import play_match\n"
             "from spacewar import Rules\n"
             "def on_frame(game):\n"
             "    if int(game.frame[0]) % 25 == 0:\n"
@@ -434,8 +434,8 @@ def test_a_forged_ready_message_is_text_not_code():
 def test_the_bot_is_stopped_between_its_turns():
     """Out of its turn a bot's process is stopped (SIGSTOP), so it cannot think ahead or take
     the CPU from the other bot; it runs again only when it is asked."""
-    from spacewar.game import Game
-    from spacewar.seats import ProcessSeat
+    from spacewar.game.game import Game
+    from spacewar.sandbox.process import ProcessSeat
 
     game = Game(SHORT, seeds=[1])
     seat = ProcessSeat(f"{HOSTILE}:DoNothing", 1, ROOMY, SHORT)
@@ -509,7 +509,7 @@ def test_bot_has_no_network(tmp_path):
 
 
 def test_sandbox_probe_reports_every_layer_here():
-    from spacewar.sandbox_probe import probe
+    from spacewar.sandbox.probe import probe
 
     findings = probe()
     assert findings["ok"], findings
@@ -633,12 +633,12 @@ def test_inline_bot_reaches_no_rules_but_its_own_copy():
 
 
 def test_a_process_that_cannot_start_is_a_start_up_fault(monkeypatch):
-    import spacewar.seats
+    import spacewar.sandbox.process
 
     def refuse(*args, **kwargs):
         raise BlockingIOError(11, "Resource temporarily unavailable")
 
-    monkeypatch.setattr(spacewar.seats.subprocess, "Popen", refuse)
+    monkeypatch.setattr(spacewar.sandbox.process.subprocess, "Popen", refuse)
     open_fds = len(os.listdir("/proc/self/fd"))
     for _ in range(3):
         result = play(f"{HOSTILE}:DoNothing", "idle")
@@ -674,10 +674,10 @@ def test_a_bot_copies_only_this_checkout_s_compiled_code(tmp_path, monkeypatch):
     import hashlib
 
     from engine.cache import cache_dir
-    from spacewar import seats
+    from spacewar.sandbox import provision
 
     monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
-    here = os.path.join(seats._PROJECT_ROOT, "spacewar")
+    here = os.path.join(provision.PROJECT_ROOT, "spacewar")
     elsewhere = "/elsewhere/checkout/spacewar"
     mine, other = (os.path.join(cache_dir("spacewar"), "spacewar_" + hashlib.sha1(
         path.encode()).hexdigest()) for path in (here, elsewhere))
@@ -685,7 +685,7 @@ def test_a_bot_copies_only_this_checkout_s_compiled_code(tmp_path, monkeypatch):
         os.makedirs(directory)
         with open(os.path.join(directory, "learning.f-1.py311.nbi"), "wb") as f:
             f.write(b"index")
-    pairs = seats._compiled_code_dirs.__wrapped__()
+    pairs = provision.compiled_code_dirs.__wrapped__()
     assert [source for source, _ in pairs] == [mine]
     assert pairs[0][1] == os.path.relpath(mine, str(tmp_path))
 
@@ -693,7 +693,7 @@ def test_a_bot_copies_only_this_checkout_s_compiled_code(tmp_path, monkeypatch):
 def test_compiled_code_is_copied_whole_within_its_budget_or_not_at_all(tmp_path, monkeypatch):
     import shutil
 
-    from spacewar.confinement import _copy_compiled_code
+    from spacewar.sandbox.confinement import _copy_compiled_code
 
     pairs = []
     # a tmpfs charges whole 4 KiB pages: a takes 3, b 7 (1, 2 and 3 for its data files, 1 for

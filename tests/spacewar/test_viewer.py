@@ -14,13 +14,13 @@ import random  # noqa: E402
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
-from spacewar import keys as K  # noqa: E402
+from spacewar.view import keys as K  # noqa: E402
 from spacewar import replay as replay_io  # noqa: E402
-from spacewar.game import Checkpoint, Game  # noqa: E402
-from spacewar.match import play_match  # noqa: E402
+from spacewar.game.game import Checkpoint, Game  # noqa: E402
+from spacewar.arena.match import play_match  # noqa: E402
 from spacewar.rules import Rules  # noqa: E402
-from spacewar.timeline import ReplayTimeline  # noqa: E402
-from spacewar.viewer import (NoDisplayError, Pace, ReplayView, check_display,  # noqa: E402
+from spacewar.replay.timeline import ReplayTimeline  # noqa: E402
+from spacewar.view.window import (NoDisplayError, Pace, ReplayView, check_display,  # noqa: E402
                              check_speed)
 
 
@@ -277,7 +277,7 @@ def pygame(optional):
 
 def scripted_view(rep, script, **options):
     """The replay window run by ``script`` (its tests ask for the ``pygame`` fixture)."""
-    from spacewar.viewer import view_replay
+    from spacewar.view.window import view_replay
 
     log = {}
 
@@ -346,7 +346,7 @@ def test_clicking_the_bar_jumps_there(classic, pygame):
             seen.append(view.timeline.frame)
         return on_tick
 
-    from spacewar.viewer import view_replay
+    from spacewar.view.window import view_replay
 
     seen = []
     view_replay(rep, fps=60, scale=256, script=[(0, {"space"}), (1, set()), (12, {"q"})],
@@ -370,7 +370,7 @@ def test_replay_view_without_a_display_exits_2(classic, tmp_path, monkeypatch, c
 
 
 def test_replay_view_from_the_command_line(classic, tmp_path, monkeypatch, capsys, pygame):
-    from spacewar import viewer
+    from spacewar.view import window as viewer
     from spacewar.cli import main
 
     path = tmp_path / "game.json"
@@ -417,7 +417,7 @@ def test_a_closed_window_keeps_no_font_file_open(pygame):
     """Each window's fonts held pygame's font file open after ``close``: a program opening
     window after window ran out of descriptors (the test suite left 42 open, and a confined
     bot host started after it got pipe numbers past its limit of 64)."""
-    from spacewar.viewer import Window
+    from spacewar.view.window import Window
 
     before = _open_font_files()
     for _ in range(3):

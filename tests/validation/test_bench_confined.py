@@ -1,11 +1,11 @@
 """The Spacewar section of the bench reports a confined match that went differently (a bot
 that faulted or could not start) instead of crashing the whole run."""
-import spacewar.match
+import spacewar.arena.match
 from validation import bench
 
 
 def test_a_faulting_confined_bot_is_reported_not_fatal(monkeypatch):
-    real = spacewar.match.play_match
+    real = spacewar.arena.match.play_match
 
     def play_match(p1, p2, **kwargs):
         if kwargs.get("isolation") != "process":
@@ -17,7 +17,7 @@ def test_a_faulting_confined_bot_is_reported_not_fatal(monkeypatch):
                               "startup_seconds": 0.5, "play_seconds": 0.0,
                               "play_frames_per_second": 0.0}
 
-    monkeypatch.setattr(spacewar.match, "play_match", play_match)
+    monkeypatch.setattr(spacewar.arena.match, "play_match", play_match)
     report = {"spacewar": bench.bench_spacewar(matches=2, frames=5, repeats=1)}
     conf = report["spacewar"]["one_match_confined_bots"]
     assert conf["agrees_with_inline"] is False

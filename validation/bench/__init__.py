@@ -17,7 +17,7 @@ of the ratios is reported (with the median times). Sections:
    matches advanced together;
 7. ``engine.Batch``: 4096 systems of the game's size advanced by one call, against one
    ``Simulation.step`` call per system, at 1 thread and at every thread;
-8. ``spacewar.learning.LearningBatch``: 4096 matches stepped with observations and rewards,
+8. ``spacewar.learn.batch.LearningBatch``: 4096 matches stepped with observations and rewards,
    at 1 thread and at every thread;
 9. the planetary integrators on the outer solar system (Sun, four giants and Pluto): time per
    step of the engine's ``whfast`` with corrector 11 and of ``ias15`` (epsilon 1e-9) against

@@ -31,7 +31,7 @@ def _noop(i):
 
 
 def _tournament(games, rounds, **where):
-    from spacewar.tournament import run_tournament
+    from spacewar.arena.tournament import run_tournament
 
     start = time.perf_counter()
     report, _ = run_tournament(BOTS, games=games, rounds=rounds, progress=False, **where)
@@ -52,10 +52,10 @@ def _per_task_seconds(client, tasks=1000):
 def _task_bytes(games, rounds):
     """Pickled sizes of one tournament task's arguments and result, and the task's matches."""
     from engine import cluster
-    from spacewar import cluster_play
+    from spacewar.arena import cluster as cluster_play
     from spacewar.rules import Rules
-    from spacewar.seats import Limits
-    from spacewar.tournament import make_jobs, schedule
+    from spacewar.sandbox.limits import Limits
+    from spacewar.arena.tournament import make_jobs, schedule
 
     jobs = make_jobs(schedule(BOTS, games, 1), rounds, Rules(), Limits(), 25, "auto", frozenset())
     chunk = cluster.chunk(jobs, 2)[0]
@@ -83,12 +83,12 @@ def bench_cluster(quick=False):
     except ImportError:
         return {"skipped": "the [cluster] extra is not installed: pip install -e '.[cluster]'"}
     from engine import cluster
-    from spacewar.tournament import warm_up_game
+    from spacewar.arena.tournament import warm_up_game
     from validation.settings import LEVELS
 
     games, rounds = (9, 1) if quick else (34, 1)
     level = LEVELS["smoke" if quick else "quick"]
-    cluster.warm_up(["spacewar.tournament:warm_up_game", "validation.report:warm_up"])
+    cluster.warm_up(["spacewar.arena.jobs:warm_up_game", "validation.report:warm_up"])
     warm_up_game()
     local, local_s = _tournament(games, rounds, workers=os.cpu_count() or 1)
     one_process, one_process_s = _tournament(games, rounds, workers=1)

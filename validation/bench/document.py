@@ -53,7 +53,7 @@ HOW_THE_TARGETS_ARE_MET = """How the engine gets there (the figures are this run
   reference counting.
   What is left is mostly numba's own front end, not LLVM's optimiser: with LLVM's
   optimisation off (`NUMBA_OPT=0`) the tour still compiles for 48 s, and typing, inlining and
-  lowering each integrator's loop is what remains. The game's frame (`spacewar.core.step_match`,
+  lowering each integrator's loop is what remains. The game's frame (`spacewar.game.core.step_match`,
   10 s) is compiled once and inlined by LLVM into its three callers. What each command compiled
   and never used before this work is gone: all ten force kernels inlined into every integrator
   (four copies in the Wisdom-Holman kick), the fused-gravity executor in scenes that cannot

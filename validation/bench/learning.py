@@ -1,5 +1,5 @@
-"""Section 8: Spacewar for learning code, ``spacewar.learning.LearningBatch`` and
-``spacewar.envs.SpacewarVectorEnv`` stepping 4096 matches with observations and rewards, at 1
+"""Section 8: Spacewar for learning code, ``spacewar.learn.batch.LearningBatch`` and
+``spacewar.learn.envs.SpacewarVectorEnv`` stepping 4096 matches with observations and rewards, at 1
 thread and at every thread; and the harness's own cost per frame of a match of Python bots."""
 import math
 import time
@@ -23,7 +23,7 @@ def _vector_env_rate(opponent, matches, frames, repeats, seed=1, copy=True):
     included; match-frames per second but in self-play, ``opponent=None``, where ``matches``
     agents are ``matches / 2`` matches) and the final observations, so that runs at different
     thread counts can be compared."""
-    from spacewar.envs import SpacewarVectorEnv
+    from spacewar.learn.envs import SpacewarVectorEnv
 
     env = SpacewarVectorEnv(matches, opponent=opponent, max_frames=3000, copy=copy)
     env.reset(seed=seed)
@@ -45,7 +45,7 @@ def bench_learning(matches=4096, frames=50, repeats=5, opponents=("random", "cha
     opponent (the learner's actions random), and in self-play (both seats learners: agent-steps
     per second, two per match-frame). Each figure is the best of ``repeats`` runs: this
     machine's speed varies by up to 2x from one minute to the next."""
-    from spacewar.learning import LearningBatch, compiled_bots
+    from spacewar.learn.batch import LearningBatch, compiled_bots
 
     codes = np.random.default_rng(0).integers(0, 24, size=(frames, matches, 2))
     opponents = [o for o in opponents if o in compiled_bots.KINDS]
@@ -84,7 +84,7 @@ def bench_harness(rounds=1, repeats=5):
     observations)."""
     from spacewar import Game, Rules
     from spacewar.bots.idle import Idle
-    from spacewar.match import play_match
+    from spacewar.arena.match import play_match
 
     play_match("idle", "idle", seed=1, rounds=1)  # compiled code loaded
     per_frame = math.inf

@@ -19,7 +19,7 @@ def run(quick):
 
 def bench_spacewar(matches=256, frames=2000, repeats=5):
     from spacewar import Game, Rules
-    from spacewar.match import play_match
+    from spacewar.arena.match import play_match
 
     play_match("chaser", "sniper", seed=1, rounds=1)  # compiled code loaded, bots' too
     # The same match inline and with both bots each in its own confined process (as untrusted
@@ -82,7 +82,8 @@ def _confined_ready_seconds(spec, repeats):
     """Median seconds from opening a confined seat for ``spec`` to its bot's being ready (its
     process started and confined, its module imported, the bot made and reset)."""
     from spacewar import Rules
-    from spacewar.seats import Limits, ProcessSeat
+    from spacewar.sandbox.limits import Limits
+    from spacewar.sandbox.process import ProcessSeat
 
     seconds = []
     for _ in range(repeats):

@@ -8,7 +8,7 @@ loopback), IPC, UTS and mount namespaces with a private /proc. ``--kill-child`` 
 parent-death signal (``PR_SET_PDEATHSIG``) tie the whole tree to the match process: if the
 match dies, so does the bot, whatever it started.
 
-The bot side (``confine``), run by ``spacewar.bothost`` before the bot's module is imported:
+The bot side (``confine``), run by ``spacewar.sandbox.bothost`` before the bot's module is imported:
 
 - a size-limited tmpfs as its only writable directory (inside its mount namespace);
 - resource limits (``setrlimit``): address space, CPU seconds, open files, file size, no core
@@ -110,7 +110,7 @@ def launch_plan():
     """
     if not sys.platform.startswith("linux") or shutil.which("unshare") is None:
         return (), None, False
-    check = [sys.executable, "-s", "-B", "-c", "import numpy, spacewar.bothost"]
+    check = [sys.executable, "-s", "-B", "-c", "import numpy, spacewar.sandbox.bothost"]
     nobody = (os.geteuid() == 0 and shutil.which("setpriv") is not None
               and _works(_as_nobody() + check))
     plans = []
@@ -192,7 +192,7 @@ def confine(config):
     if libc is not None:
         signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # an over-long write fails, not the bot
         _drop_bounding_set(libc)
-        from . import landlock
+        from spacewar.sandbox import landlock
 
         if landlock.abi_version() >= 1:  # offered by the kernel: it must hold, or no bot runs
             abi = landlock.restrict(read_dirs=config["read_dirs"],
@@ -362,8 +362,7 @@ def _installed_read_paths():
     # that would be all of /usr), and the executable itself
     dirs = {os.path.join(prefix, lib) for prefix in {sys.base_prefix, sys.exec_prefix}
             for lib in ("lib", "lib64")}
-    dirs |= {sys.prefix, os.path.dirname(os.path.abspath(__file__)),
-             os.path.dirname(os.path.dirname(numpy.__file__))}
+    dirs |= {sys.prefix, os.path.dirname(os.path.dirname(numpy.__file__))}
     paths = sysconfig.get_paths()
     dirs.update(paths[key] for key in ("stdlib", "platstdlib", "purelib", "platlib"))
     try:

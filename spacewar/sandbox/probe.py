@@ -1,6 +1,6 @@
 """``spacewar sandbox``: a probe bot tries each attack from inside the bot sandbox.
 
-The probe is started exactly as an untrusted bot is (``spacewar.seats.ProcessSeat``), tries
+The probe is started exactly as an untrusted bot is (``spacewar.sandbox.process.ProcessSeat``), tries
 each thing a hostile bot would in its ``reset`` and prints what happened to its stdout, which
 the match side captures. ``probe()`` returns the findings; each check is ``blocked`` or
 ``allowed``, and ``ok`` says whether every one came out as the sandbox intends on this
@@ -9,7 +9,7 @@ machine.
 import json
 import os
 
-from .protocol import NOOP
+from spacewar.protocol import NOOP
 
 #: check -> the outcome the sandbox intends
 EXPECTED = {
@@ -114,10 +114,11 @@ class Probe:
 
 def probe():
     """Run the probe in a bot sandbox; return ``{"layers", "checks", "ok"}``."""
-    from .seats import SHOWN_OUTPUT, Limits, ProcessSeat
-    from .rules import Rules
+    from spacewar.sandbox.process import SHOWN_OUTPUT, ProcessSeat
+    from spacewar.sandbox.limits import Limits
+    from spacewar.rules import Rules
 
-    seat = ProcessSeat("spacewar.sandbox_probe:Probe", 0, Limits(startup=30.0), Rules())
+    seat = ProcessSeat("spacewar.sandbox.probe:Probe", 0, Limits(startup=30.0), Rules())
     fault = seat.wait_ready()
     output = seat.close()
     if fault is not None:

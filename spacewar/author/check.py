@@ -7,9 +7,9 @@ seats, and reports
 
 * a load error (unknown name, missing file, import, construction or ``reset`` failing);
 * its faults: the count of each kind (``raised``, ``invalid``, ``timeout``, ``crashed``,
-  ``startup``, ``memory``, see ``spacewar.seats``) and the first messages, and its forfeits;
+  ``startup``, ``memory``, see ``spacewar.sandbox.process``) and the first messages, and its forfeits;
 * the time of its actions (p50, p95, p99, max, as charged against the per-action budget;
-  ``spacewar.seats``), pooled over every match;
+  ``spacewar.sandbox.process``), pooled over every match;
 * whether it is deterministic: the first match is played again with the same seed, and the
   two plays' results and replays (every frame's actions and faults, the final state's
   SHA-256) must be identical;
@@ -31,11 +31,12 @@ import json
 
 import numpy as np
 
-from .bots import BotLoadError, available, locate
-from .match import DEFAULT_MAX_FAULTS, check_bot_argument, act_time_summary, play_match
-from .rules import Rules, count_at_least
-from .faults import FAULT_KINDS, printable
-from .seats import Limits, bot_name
+from spacewar.bots import BotLoadError, available, locate
+from spacewar.arena.match import DEFAULT_MAX_FAULTS, check_bot_argument, act_time_summary, play_match
+from spacewar.rules import Rules, count_at_least
+from spacewar.faults import FAULT_KINDS, printable
+from spacewar.sandbox.limits import Limits
+from spacewar.arena.seats import bot_name
 
 #: a p99 action time above this fraction of the budget is a warning (little headroom)
 HEADROOM = 0.5
@@ -57,7 +58,7 @@ class CheckReport:
     ``faults``: {kind: count} over those matches (the determinism replay is compared, not
     counted); ``fault_examples``: the first few, each with its match's opponent, seat and
     seed; ``forfeits``: how many of those matches it forfeited. ``act``: the action-time
-    summary in seconds (``spacewar.match.act_time_summary``) over those matches,
+    summary in seconds (``spacewar.arena.match.act_time_summary``) over those matches,
     ``over_budget`` how many actions took longer than ``budget``, the per-action budget in
     seconds. ``deterministic``: True, False, or None when not checked (the bot could not
     start); ``determinism``: what was compared and what differed. ``output_bytes``: how many
@@ -122,9 +123,9 @@ def check_bot(bot, *, opponents=None, games=None, seed=0, rounds=1, rules=None, 
 
     It plays ``games`` seeds (``seed``, ``seed + 1``, ...) against each of ``opponents``
     (default every built-in bot) from both seats, each match of ``rounds`` rounds under
-    ``rules`` and ``limits`` (a ``spacewar.seats.Limits``; default the match defaults), then
+    ``rules`` and ``limits`` (a ``spacewar.sandbox.limits.Limits``; default the match defaults), then
     the first match once more to compare. The matches are grouped as a tournament groups
-    its own (``spacewar.tournament``): a bot named by a file that plays as a batch bot (or a
+    its own (``spacewar.arena.tournament``): a bot named by a file that plays as a batch bot (or a
     policy file) plays each opponent's ``2 * games`` matches together, answering for all of
     them at once, so it cannot tell a check from a tournament by its batch size; its
     ``games`` default to a tournament's (``TOURNAMENT_GAMES``), every other bot's to 1, and
@@ -198,7 +199,7 @@ def _checked_arguments(bot, opponents, games, seed, rounds, rules, limits, max_f
         raise TypeError(f"rules must be a spacewar.Rules, got {rules!r}")
     limits = Limits() if limits is None else limits
     if not isinstance(limits, Limits):
-        raise TypeError(f"limits must be a spacewar.seats.Limits, got {limits!r}")
+        raise TypeError(f"limits must be a spacewar.sandbox.limits.Limits, got {limits!r}")
     return opponents, rules, limits
 
 
@@ -211,7 +212,7 @@ def _schedule(opponents, games, seed):
 def _batch_files(bot, opponents):
     """The bots from files among ``bot`` and ``opponents`` that a tournament plays as batch
     bots (``jobs.batch_files_of``); none are run to find out."""
-    from .jobs import batch_files_of
+    from spacewar.arena.jobs import batch_files_of
 
     return batch_files_of([x for x in [bot, *opponents] if isinstance(x, str)])
 
@@ -221,7 +222,7 @@ def _plays_together(bot, batch_files, isolation):
     specification of a batch bot or a policy file (``batch_match.is_batch_spec``), unless
     every match is confined alone (``isolation="process"``). A bot object is the caller's own
     code, which no tournament plays: it plays its matches one at a time."""
-    from .batch_match import is_batch_spec
+    from spacewar.arena.batch_match import is_batch_spec
 
     return isinstance(bot, str) and isolation != "process" and is_batch_spec(bot, batch_files)
 
@@ -230,7 +231,7 @@ def _jobs(bot, opponents, games, seed, isolation, batch_files):
     """The schedule cut as a tournament cuts its own (``jobs.group_jobs``): a list of
     ``(entries, together)``, ``entries`` the ``(opponent, seed, seat)`` of each match of a
     job, ``together`` whether they are played in one game (``batch_match.play_matches``)."""
-    from .jobs import group_jobs
+    from spacewar.arena.jobs import group_jobs
 
     schedule = _schedule(opponents, games, seed)
     if not isinstance(bot, str):
@@ -252,7 +253,7 @@ def _play_job(bot, entries, together, play, record):
         (opponent, game_seed, seat), = entries
         return [play_match(*_seated(bot, opponent, seat), seed=game_seed, record=record,
                            act_seconds=True, **options)]
-    from .batch_match import play_matches
+    from spacewar.arena.batch_match import play_matches
 
     options.pop("isolation")  # together only when it is not "process"
     matches = [(*_seated(bot, opponent, seat), s) for opponent, s, seat in entries]

@@ -1,6 +1,6 @@
 """The referee: how one frame of a match is judged, written once for every place a match is
-played (``spacewar.match.play_match``, ``spacewar.batch_match.play_matches``, the window's
-``spacewar.play.LiveMatch``) and for the replay check that re-judges a recorded match
+played (``spacewar.arena.match.play_match``, ``spacewar.arena.batch_match.play_matches``, the window's
+``spacewar.view.live.LiveMatch``) and for the replay check that re-judges a recorded match
 (``spacewar.replay.check``).
 
 Each frame both seats are asked (seat index 0 first). A fault costs the seat its turn (the
@@ -13,8 +13,8 @@ action codes recorded.
 """
 import math
 
-from . import core
-from .faults import FaultLog, fault_code
+from spacewar.game import core
+from spacewar.faults import FaultLog, fault_code
 
 
 class Referee:

@@ -1,7 +1,7 @@
 """Tournament and league matches on a Dask cluster (``engine.cluster``).
 
 The matches of a run are cut into tasks of many matches each; a task plays its matches on the
-worker exactly as a local worker process would (``spacewar.jobs.play_job``: every bot that
+worker exactly as a local worker process would (``spacewar.arena.jobs.play_job``: every bot that
 is not built in in its own confined process, with the same limits), so the results are the
 same, and they are put back in schedule order.
 
@@ -26,10 +26,10 @@ import tempfile
 
 from engine import cluster
 
-from . import confinement
-from .bots import BotLoadError, is_builtin, is_file_spec, is_policy_file, split_spec
-from .seats import sweep_stale_directories
-from .strangers_files import FileRefused, read_bounded
+from spacewar.sandbox import confinement
+from spacewar.bots import BotLoadError, is_builtin, is_file_spec, is_policy_file, split_spec
+from spacewar.sandbox.provision import sweep_stale_directories
+from spacewar.strangers_files import FileRefused, read_bounded
 
 #: the largest bot file sent to a cluster (a policy file included)
 MAX_BOT_BYTES = 64 << 20
@@ -134,7 +134,7 @@ def play_chunk(task, fingerprint):
     """A task: the outcomes of each job of ``task = (jobs, files)`` (``jobs.play_job``),
     with the client's bot names; ``files`` holds the bots from files those jobs play."""
     cluster.check_code(fingerprint)
-    from .jobs import play_job
+    from spacewar.arena.jobs import play_job
 
     jobs, files = task
     out = []
@@ -162,7 +162,7 @@ class _GameConnection:
 
     def __init__(self, address, bots):
         self.files = bot_files(bots)
-        self.connection = cluster.Connection(address, warm=("spacewar.jobs:warm_up_game",))
+        self.connection = cluster.Connection(address, warm=("spacewar.arena.jobs:warm_up_game",))
 
     def close(self):
         self.connection.close()

@@ -43,7 +43,7 @@ HEADING, OMEGA, FUEL, SF = 0, 1, 2, 3
  R_ELECTRIC, R_THRUST_OFF, RN) = range(36)
 
 # action codes: turn index (0, 1, 2 for -1, 0, +1) + 3 thrust + 6 fire + 12 hyperspace + 24 flip
-from .codes import N_ACTIONS, NOOP  # noqa: E402  (kept here: core.NOOP is used throughout)
+from spacewar.codes import N_ACTIONS, NOOP  # noqa: E402  (kept here: core.NOOP is used throughout)
 
 #: numba's njit with this module's compiled code in the game's cache directory
 jit = compiler("spacewar")

@@ -4,7 +4,7 @@ the progress bar they report to."""
 import concurrent.futures
 import multiprocessing
 
-from .jobs import play_job, warm_up, worker_start
+from spacewar.arena.jobs import play_job, warm_up, worker_start
 
 
 class MatchRunner:
@@ -42,7 +42,7 @@ class MatchRunner:
         return [outcome for f in futures for outcome in f.result()]
 
     def _play_on_cluster(self, jobs, progress):
-        from . import cluster_play
+        from spacewar.arena import cluster as cluster_play
 
         if self._connection is None:
             self._connection = cluster_play.connect(self.address, self.bots)

@@ -1,13 +1,13 @@
 """The bot's own process: confine itself, load the bot, answer observations over the wire.
 
-Started by ``spacewar.seats.ProcessSeat`` as ``python -I -m spacewar.bothost IN OUT`` (the
+Started by ``spacewar.sandbox.process.ProcessSeat`` as ``python -I -m spacewar.sandbox.bothost IN OUT`` (the
 file descriptors of its two pipes), possibly under ``unshare``. Nothing of the bot runs
 before ``confinement.confine`` has applied every layer; from then on the bot's module is
 imported, its class checked, constructed and reset here, and the match only ever learns
 "ready" or a start-up fault with a message.
 
 Started with ``batch`` in its configuration (a count of matches), it hosts a batch bot
-(``spacewar.batch_bots``): one instance answers BATCH messages, all those matches' learning
+(``spacewar.bots.batch``): one instance answers BATCH messages, all those matches' learning
 observations at once, with CODES. Its answers are checked here for helpful messages,
 and again by the match, which trusts nothing that arrives.
 """
@@ -16,9 +16,9 @@ import json
 import os
 import sys
 
-from . import wire
-from .ask import ask
-from .protocol import observation_of_copy, raw_length
+from spacewar import wire
+from spacewar.bots.ask import ask
+from spacewar.protocol import observation_of_copy, raw_length
 
 
 def _read_exact(fd, n):
@@ -95,12 +95,12 @@ def _capture_output(cap):
 
 
 def _load(config):
-    from .bots import import_top_level, make_bot
-    from .rules import Rules
+    from spacewar.bots import import_top_level, make_bot
+    from spacewar.rules import Rules
 
     if config.get("path"):  # a module:Class bot: its module from where the match found it
         import_top_level(config["spec"], config["path"])
-    from .batch_bots import is_batch_bot, one_match_bot
+    from spacewar.bots.batch import is_batch_bot, one_match_bot
 
     rules = Rules.from_dict(config["rules"])
     bot = make_bot(config["spec"], seed=config["seed"])
@@ -127,7 +127,7 @@ def _answer(bot, rules, frame, raw):
 
 def _answer_batch(bot, call, obs):
     """The CODES message of batch ``bot`` to the observations ``obs`` of ``call``."""
-    from .batch_bots import ask_batch
+    from spacewar.bots.batch import ask_batch
 
     status, codes, text = ask_batch(bot, obs)
     return wire.pack_codes(call, status, codes if status == wire.OK else b"", text)
@@ -139,7 +139,7 @@ def main(argv):
         config = wire.read_start(lambda n: _read_exact(fd_in, n))
     except (EOFError, OSError, ValueError):
         os._exit(2)
-    from . import confinement
+    from spacewar.sandbox import confinement
 
     try:
         layers = confinement.confine(config["confinement"])

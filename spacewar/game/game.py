@@ -19,9 +19,10 @@ import numpy as np
 
 from engine import Batch, forces
 
-from . import core, features
-from .protocol import Action, observation_from_raw, raw_length
-from .rules import Rules, count_at_least
+from spacewar.game import core
+from spacewar.game import features
+from spacewar.protocol import Action, observation_from_raw, raw_length
+from spacewar.rules import Rules, count_at_least
 
 
 def force_terms(rules):
@@ -270,7 +271,7 @@ class Game:
 
     def learning_observations(self, out=None):
         """Every match's two seats as learning observations, (M, 2, D) float32, written by
-        compiled code into ``out`` if given (``spacewar.features.learning_layout`` names the
+        compiled code into ``out`` if given (``spacewar.game.features.learning_layout`` names the
         D entries)."""
 
         shape = (self.n_matches, 2, features.learning_length(self.rules))
@@ -355,7 +356,7 @@ class Game:
         Restoring it and stepping with the same action codes gives bit-identical states
         (``state_hash``) to the run that made it: the frame is a pure function of these arrays
         and the codes. Each checkpoint is about 5 KB under the 1962 rules (32 torpedoes a
-        ship); ``spacewar.timeline`` keeps a bounded number of them to scrub a replay.
+        ship); ``spacewar.replay.timeline`` keeps a bounded number of them to scrub a replay.
         """
         m = self._match_index(m)
         self.sync_with_batch()
