@@ -39,7 +39,7 @@ from spacewar.view.gif import render_gif  # noqa: F401
 from spacewar.view.look import VIZ_HINT  # noqa: F401
 from spacewar.view.paint_pil import (PALETTE, new_image, paint_pil, palette_index, render_frame,  # noqa: F401
                         require_pillow)
-from spacewar.view.scene import Effects, footer_top, frame_snapshot, hud_bottom, scene, to_pixels  # noqa: F401
+from spacewar.view.scene import (Effects, footer_top, frame_snapshot, hud_bottom, scene, to_pixels)  # noqa: F401
 
 __all__ = ["Effects", "render_frame", "render_gif", "scene", "frame_snapshot", "paint_pil",
            "new_image", "palette_index", "require_pillow", "to_pixels", "footer_top",

@@ -19,7 +19,7 @@ import numpy as np
 
 from spacewar.faults import printable
 # the jobs' names, public here too (a tournament's work is cut by them)
-from spacewar.arena.jobs import batch_files_of, group_jobs, make_jobs, match_record, warm_up_game  # noqa: F401
+from spacewar.arena.jobs import (batch_files_of, group_jobs, make_jobs, match_record, warm_up_game)  # noqa: F401
 from spacewar.arena.match import DEFAULT_BUDGET, DEFAULT_MAX_FAULTS
 from spacewar.rules import Rules
 from spacewar.arena.ratings import bradley_terry_elo

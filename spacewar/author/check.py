@@ -32,7 +32,8 @@ import json
 import numpy as np
 
 from spacewar.bots import BotLoadError, available, locate
-from spacewar.arena.match import DEFAULT_MAX_FAULTS, check_bot_argument, act_time_summary, play_match
+from spacewar.arena.match import (DEFAULT_MAX_FAULTS, check_bot_argument, act_time_summary,
+                                  play_match)
 from spacewar.rules import Rules, count_at_least
 from spacewar.faults import FAULT_KINDS, printable
 from spacewar.sandbox.limits import Limits

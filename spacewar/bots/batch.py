@@ -96,7 +96,7 @@ class SingleFromBatch:
     score and round count by it)."""
 
     def __init__(self, bot, rules, rounds):
-        from spacewar.game.features import learning_vector  # imported now, in the bot's start-up time
+        from spacewar.game.features import (learning_vector)  # imported now, in the bot's start-up time
 
         self.bot = bot
         self.rules = rules

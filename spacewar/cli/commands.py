@@ -184,7 +184,7 @@ def _cmd_replay(args):
 
 
 def _view_replay(data, args):
-    from spacewar.view.window import view_replay
+    from spacewar.view.replay_view import view_replay
 
     summary = view_replay(data, fps=args.fps, scale=args.window_size, speed=args.speed)
     end = {True: "the final state is the recorded one", False: "the final state DIFFERS "

@@ -65,7 +65,8 @@ except ImportError as error:  # pragma: no cover - the extra is missing
 
 from spacewar.game import core
 from spacewar.codes import codes_from_parts
-from spacewar.learn.batch import LearningBatch, copy_rows, learning_layout, learning_length, seat_kinds
+from spacewar.learn.batch import (LearningBatch, copy_rows, learning_layout, learning_length,
+                                  seat_kinds)
 from spacewar.game import compiled_bots
 from spacewar.bots.batch import checked_codes
 from spacewar.protocol import action_code

@@ -5,7 +5,8 @@ import os
 
 from engine.atomic import atomic_write, check_output_path
 
-from spacewar.replay.format import DIGEST_FIELD, MAX_FILE_BYTES, ReplayError, VERSION, canonical_json, digest
+from spacewar.replay.format import (DIGEST_FIELD, MAX_FILE_BYTES, ReplayError, VERSION,
+                                    canonical_json, digest)
 from spacewar.replay.schema import validate
 from spacewar.replay.signing import SIGNATURE_FIELD, sign
 from spacewar.strangers_files import FileRefused, read_bounded

@@ -8,7 +8,8 @@ import numpy as np
 from engine.atomic import atomic_write, check_output_path
 
 from spacewar.view.look import DEFAULT_NAMES, FINAL_HOLD_MS
-from spacewar.view.paint_pil import PALETTE_BYTES, TRANSPARENT, check_size, render_frame, require_pillow
+from spacewar.view.paint_pil import (PALETTE_BYTES, TRANSPARENT, check_size, render_frame,
+                                     require_pillow)
 from spacewar.view.scene import Effects, frame_snapshot
 
 

@@ -33,7 +33,8 @@ from spacewar.game import core
 from spacewar.view import keys as K
 from spacewar.game.game import Game
 from spacewar.faults import FAULT_KINDS, printable
-from spacewar.arena.match import DEFAULT_MAX_FAULTS, bot_seed, checked_limits, cpu_seconds, match_result
+from spacewar.arena.match import (DEFAULT_MAX_FAULTS, bot_seed, checked_limits, cpu_seconds,
+                                  match_result)
 from spacewar.protocol import Action, raw_length
 from spacewar.game.referee import Referee
 from spacewar.view.look import DIM_TEXT, TEXT

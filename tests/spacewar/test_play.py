@@ -21,7 +21,7 @@ from spacewar.view import live as play_module  # noqa: E402
 from spacewar import replay as replay_io  # noqa: E402
 from spacewar.view import window as viewer  # noqa: E402
 from spacewar.arena.match import play_match  # noqa: E402
-from spacewar.view.live import format_summary, held_keys_code, play, play_script_source, watch  # noqa: E402
+from spacewar.view.live import (format_summary, held_keys_code, play, play_script_source, watch)  # noqa: E402
 from spacewar.protocol import Action  # noqa: E402
 from spacewar.rules import Rules  # noqa: E402
 from spacewar.sandbox.limits import Limits  # noqa: E402

@@ -13,7 +13,8 @@ from spacewar.author.check import check_bot
 from spacewar.cli import main
 from spacewar.arena.match import play_match
 from spacewar.sandbox.limits import Limits
-from spacewar.arena.tournament import batch_files_of, group_jobs, make_jobs, run_tournament, schedule
+from spacewar.arena.tournament import (batch_files_of, group_jobs, make_jobs, run_tournament,
+                                       schedule)
 from spacewar.arena.jobs import play_job as tournament_play
 
 from . import hostile_batch_bots  # the same classes, played as objects

@@ -20,8 +20,8 @@ from spacewar.game.game import Checkpoint, Game  # noqa: E402
 from spacewar.arena.match import play_match  # noqa: E402
 from spacewar.rules import Rules  # noqa: E402
 from spacewar.replay.timeline import ReplayTimeline  # noqa: E402
-from spacewar.view.window import (NoDisplayError, Pace, ReplayView, check_display,  # noqa: E402
-                             check_speed)
+from spacewar.view.replay_view import ReplayView  # noqa: E402
+from spacewar.view.window import NoDisplayError, Pace, check_display, check_speed  # noqa: E402
 
 
 def straight_hashes(rep):
@@ -277,7 +277,7 @@ def pygame(optional):
 
 def scripted_view(rep, script, **options):
     """The replay window run by ``script`` (its tests ask for the ``pygame`` fixture)."""
-    from spacewar.view.window import view_replay
+    from spacewar.view.replay_view import view_replay
 
     log = {}
 
@@ -346,7 +346,7 @@ def test_clicking_the_bar_jumps_there(classic, pygame):
             seen.append(view.timeline.frame)
         return on_tick
 
-    from spacewar.view.window import view_replay
+    from spacewar.view.replay_view import view_replay
 
     seen = []
     view_replay(rep, fps=60, scale=256, script=[(0, {"space"}), (1, set()), (12, {"q"})],
