@@ -1,12 +1,6 @@
-"""``spacewar.batch_bots``, a documented path kept: the ``act_batch`` protocol. The code lives in
-``spacewar.bots.batch``; this module only re-exports it (``docs/game.md``, "Layout"), and
-nothing inside ``spacewar`` imports it."""
-from spacewar.bots import batch as home
+"""``spacewar.batch_bots``, kept: the ``act_batch`` protocol, now ``spacewar.bots.batch``; re-
+exports only."""
 from spacewar.bots.batch import *  # noqa: F401,F403
+from spacewar.kept_paths import forward
 
-
-def __getattr__(name):
-    """Every other public name of ``spacewar.bots.batch``."""
-    if name.startswith("_") or not hasattr(home, name):
-        raise AttributeError(f"module 'spacewar.batch_bots' has no attribute {name!r}")
-    return getattr(home, name)
+__getattr__ = forward(__name__, "spacewar.bots.batch")

@@ -1,12 +1,6 @@
-"""``spacewar.batch_match``, a documented path kept: many matches as the rows of one game
-(``play_matches``). The code lives in ``spacewar.arena.batch_match``; this module only re-
-exports it (``docs/game.md``, "Layout"), and nothing inside ``spacewar`` imports it."""
-from spacewar.arena import batch_match as home
+"""``spacewar.batch_match``, kept: many matches as the rows of one game (``play_matches``), now
+``spacewar.arena.batch_match``; re-exports only."""
 from spacewar.arena.batch_match import *  # noqa: F401,F403
+from spacewar.kept_paths import forward
 
-
-def __getattr__(name):
-    """Every other public name of ``spacewar.arena.batch_match``."""
-    if name.startswith("_") or not hasattr(home, name):
-        raise AttributeError(f"module 'spacewar.batch_match' has no attribute {name!r}")
-    return getattr(home, name)
+__getattr__ = forward(__name__, "spacewar.arena.batch_match")

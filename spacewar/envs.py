@@ -1,12 +1,6 @@
-"""``spacewar.envs``, a documented path kept: the Gymnasium and PettingZoo environments; importing
-it registers ``Spacewar-v0``. The code lives in ``spacewar.learn.envs``; this module only re-
-exports it (``docs/game.md``, "Layout"), and nothing inside ``spacewar`` imports it."""
-from spacewar.learn import envs as home
+"""``spacewar.envs``, kept: the Gymnasium and PettingZoo environments; importing it registers
+``Spacewar-v0``, now ``spacewar.learn.envs``; re-exports only."""
 from spacewar.learn.envs import *  # noqa: F401,F403
+from spacewar.kept_paths import forward
 
-
-def __getattr__(name):
-    """Every other public name of ``spacewar.learn.envs``."""
-    if name.startswith("_") or not hasattr(home, name):
-        raise AttributeError(f"module 'spacewar.envs' has no attribute {name!r}")
-    return getattr(home, name)
+__getattr__ = forward(__name__, "spacewar.learn.envs")

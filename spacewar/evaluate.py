@@ -1,12 +1,6 @@
-"""``spacewar.evaluate``, a documented path kept: a policy file's evaluation. The code lives in
-``spacewar.learn.evaluate``; this module only re-exports it (``docs/game.md``, "Layout"), and
-nothing inside ``spacewar`` imports it."""
-from spacewar.learn import evaluate as home
+"""``spacewar.evaluate``, kept: a policy file's evaluation, now ``spacewar.learn.evaluate``; re-
+exports only."""
 from spacewar.learn.evaluate import *  # noqa: F401,F403
+from spacewar.kept_paths import forward
 
-
-def __getattr__(name):
-    """Every other public name of ``spacewar.learn.evaluate``."""
-    if name.startswith("_") or not hasattr(home, name):
-        raise AttributeError(f"module 'spacewar.evaluate' has no attribute {name!r}")
-    return getattr(home, name)
+__getattr__ = forward(__name__, "spacewar.learn.evaluate")

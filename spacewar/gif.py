@@ -1,12 +1,5 @@
-"""``spacewar.gif``, a documented path kept: a replay to a GIF. The code lives in
-``spacewar.view.gif``; this module only re-exports it (``docs/game.md``, "Layout"), and nothing
-inside ``spacewar`` imports it."""
-from spacewar.view import gif as home
+"""``spacewar.gif``, kept: a replay to a GIF, now ``spacewar.view.gif``; re-exports only."""
 from spacewar.view.gif import *  # noqa: F401,F403
+from spacewar.kept_paths import forward
 
-
-def __getattr__(name):
-    """Every other public name of ``spacewar.view.gif``."""
-    if name.startswith("_") or not hasattr(home, name):
-        raise AttributeError(f"module 'spacewar.gif' has no attribute {name!r}")
-    return getattr(home, name)
+__getattr__ = forward(__name__, "spacewar.view.gif")

@@ -1,12 +1,6 @@
-"""``spacewar.jobs``, a documented path kept: what a worker does with a job (``make_jobs``,
-``warm_up_game``). The code lives in ``spacewar.arena.jobs``; this module only re-exports it
-(``docs/game.md``, "Layout"), and nothing inside ``spacewar`` imports it."""
-from spacewar.arena import jobs as home
+"""``spacewar.jobs``, kept: what a worker does with a job (``make_jobs``, ``warm_up_game``), now
+``spacewar.arena.jobs``; re-exports only."""
 from spacewar.arena.jobs import *  # noqa: F401,F403
+from spacewar.kept_paths import forward
 
-
-def __getattr__(name):
-    """Every other public name of ``spacewar.arena.jobs``."""
-    if name.startswith("_") or not hasattr(home, name):
-        raise AttributeError(f"module 'spacewar.jobs' has no attribute {name!r}")
-    return getattr(home, name)
+__getattr__ = forward(__name__, "spacewar.arena.jobs")

@@ -1,12 +1,6 @@
-"""``spacewar.learning``, a documented path kept: the compiled learning batch and the observation's
-names. The code lives in ``spacewar.learn.batch``; this module only re-exports it
-(``docs/game.md``, "Layout"), and nothing inside ``spacewar`` imports it."""
-from spacewar.learn import batch as home
+"""``spacewar.learning``, kept: the compiled learning batch and the observation's names, now
+``spacewar.learn.batch``; re-exports only."""
 from spacewar.learn.batch import *  # noqa: F401,F403
+from spacewar.kept_paths import forward
 
-
-def __getattr__(name):
-    """Every other public name of ``spacewar.learn.batch``."""
-    if name.startswith("_") or not hasattr(home, name):
-        raise AttributeError(f"module 'spacewar.learning' has no attribute {name!r}")
-    return getattr(home, name)
+__getattr__ = forward(__name__, "spacewar.learn.batch")

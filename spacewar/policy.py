@@ -4,13 +4,9 @@ in ``spacewar.bots.policy`` (the ``.npz`` format, its safe loading, ``Policy``, 
 Nothing inside ``spacewar`` imports it."""
 from spacewar.bots import policy as home
 from spacewar.bots.policy import *  # noqa: F401,F403
+from spacewar.kept_paths import forward
 from spacewar.learn.evaluate import evaluate  # noqa: F401
 
 __all__ = list(home.__all__) + ["evaluate"]
 
-
-def __getattr__(name):
-    """Every other public name of ``spacewar.bots.policy`` (its limits and format constants)."""
-    if name.startswith("_") or not hasattr(home, name):
-        raise AttributeError(f"module 'spacewar.policy' has no attribute {name!r}")
-    return getattr(home, name)
+__getattr__ = forward(__name__, "spacewar.bots.policy")

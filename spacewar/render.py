@@ -31,25 +31,17 @@ This module keeps the documented path: the code lives in ``spacewar.view.look`` 
 durations), ``spacewar.view.scene`` (the primitives), ``spacewar.view.paint_pil`` (Pillow) and
 ``spacewar.view.gif`` (``render_gif``); nothing inside ``spacewar`` imports this module.
 """
-from spacewar.view import gif
-from spacewar.view import look
-from spacewar.view import paint_pil as painter
-from spacewar.view import scene as scene_module
+from spacewar.kept_paths import forward
 from spacewar.view.gif import render_gif  # noqa: F401
 from spacewar.view.look import VIZ_HINT  # noqa: F401
-from spacewar.view.paint_pil import (PALETTE, new_image, paint_pil, palette_index, render_frame,  # noqa: F401
-                        require_pillow)
-from spacewar.view.scene import (Effects, footer_top, frame_snapshot, hud_bottom, scene, to_pixels)  # noqa: F401
+from spacewar.view.paint_pil import (PALETTE, new_image, paint_pil, palette_index,  # noqa: F401
+                                     render_frame, require_pillow)
+from spacewar.view.scene import (Effects, footer_top, frame_snapshot, hud_bottom,  # noqa: F401
+                                 scene, to_pixels)
 
 __all__ = ["Effects", "render_frame", "render_gif", "scene", "frame_snapshot", "paint_pil",
            "new_image", "palette_index", "require_pillow", "to_pixels", "footer_top",
            "hud_bottom", "PALETTE", "VIZ_HINT"]
 
-
-def __getattr__(name):
-    """Every other public name the drawing modules define (colours, sizes, layout helpers)."""
-    if not name.startswith("_"):
-        for home in (look, scene_module, painter, gif):
-            if name in vars(home):
-                return vars(home)[name]
-    raise AttributeError(f"module 'spacewar.render' has no attribute {name!r}")
+__getattr__ = forward(__name__, "spacewar.view.look", "spacewar.view.scene",
+                      "spacewar.view.paint_pil", "spacewar.view.gif")

@@ -1,12 +1,5 @@
-"""``spacewar.tournament``, a documented path kept: tournaments. The code lives in
-``spacewar.arena.tournament``; this module only re-exports it (``docs/game.md``, "Layout"), and
-nothing inside ``spacewar`` imports it."""
-from spacewar.arena import tournament as home
+"""``spacewar.tournament``, kept: tournaments, now ``spacewar.arena.tournament``; re-exports only."""
 from spacewar.arena.tournament import *  # noqa: F401,F403
+from spacewar.kept_paths import forward
 
-
-def __getattr__(name):
-    """Every other public name of ``spacewar.arena.tournament``."""
-    if name.startswith("_") or not hasattr(home, name):
-        raise AttributeError(f"module 'spacewar.tournament' has no attribute {name!r}")
-    return getattr(home, name)
+__getattr__ = forward(__name__, "spacewar.arena.tournament")

@@ -1,12 +1,5 @@
-"""``spacewar.train``, a documented path kept: PPO training. The code lives in
-``spacewar.learn.train``; this module only re-exports it (``docs/game.md``, "Layout"), and
-nothing inside ``spacewar`` imports it."""
-from spacewar.learn import train as home
+"""``spacewar.train``, kept: PPO training, now ``spacewar.learn.train``; re-exports only."""
 from spacewar.learn.train import *  # noqa: F401,F403
+from spacewar.kept_paths import forward
 
-
-def __getattr__(name):
-    """Every other public name of ``spacewar.learn.train``."""
-    if name.startswith("_") or not hasattr(home, name):
-        raise AttributeError(f"module 'spacewar.train' has no attribute {name!r}")
-    return getattr(home, name)
+__getattr__ = forward(__name__, "spacewar.learn.train")

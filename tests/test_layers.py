@@ -209,3 +209,52 @@ def test_import_linter_reports_the_upward_import_too(broken):
                          text=True, env={**os.environ, "PYTHONPATH": str(broken)})
     assert out.returncode != 0
     assert "broken.low -> broken.high" in out.stdout, out.stdout
+
+
+#: the documented paths that moved, and where their code lives now (docs/game.md, "Layout")
+KEPT_PATHS = {
+    "spacewar.match": ["spacewar.arena.match"], "spacewar.envs": ["spacewar.learn.envs"],
+    "spacewar.learning": ["spacewar.learn.batch"], "spacewar.train": ["spacewar.learn.train"],
+    "spacewar.evaluate": ["spacewar.learn.evaluate"], "spacewar.policy": ["spacewar.bots.policy"],
+    "spacewar.timeline": ["spacewar.replay.timeline"],
+    "spacewar.viewer": ["spacewar.view.window", "spacewar.view.replay_view"],
+    "spacewar.play": ["spacewar.view.live"],
+    "spacewar.render": ["spacewar.view.look", "spacewar.view.scene", "spacewar.view.paint_pil",
+                        "spacewar.view.gif"],
+    "spacewar.look": ["spacewar.view.look"], "spacewar.scene": ["spacewar.view.scene"],
+    "spacewar.paint_pil": ["spacewar.view.paint_pil"], "spacewar.gif": ["spacewar.view.gif"],
+    "spacewar.seats": ["spacewar.arena.seats", "spacewar.sandbox.limits",
+                       "spacewar.sandbox.process"],
+    "spacewar.tournament": ["spacewar.arena.tournament"], "spacewar.jobs": ["spacewar.arena.jobs"],
+    "spacewar.batch_match": ["spacewar.arena.batch_match"],
+    "spacewar.batch_bots": ["spacewar.bots.batch"],
+    "spacewar.compiled_bots": ["spacewar.game.compiled_bots"],
+    "spacewar.features": ["spacewar.game.features"],
+}
+
+
+@pytest.mark.parametrize("old", sorted(KEPT_PATHS))
+def test_a_kept_path_gives_the_very_objects_of_its_new_home(old):
+    kept = importlib.import_module(old)
+    for home in map(importlib.import_module, KEPT_PATHS[old]):
+        names = getattr(home, "__all__", [n for n in vars(home) if not n.startswith("_")])
+        for name in names:
+            if old == "spacewar.seats" and name not in ("open_seat", "bot_name", "InlineSeat",
+                                                        "Limits", "TimeBank", "ProcessSeat",
+                                                        "BatchProcessSeat"):
+                continue
+            assert getattr(kept, name) is getattr(home, name), (old, name)
+    with pytest.raises(AttributeError):
+        getattr(kept, "no_such_name")
+    # a kept path holds no code of its own: imports, its docstring, ``__all__`` and the
+    # forwarding ``__getattr__`` only
+    tree = ast.parse(open(kept.__file__, encoding="utf-8").read())
+    assert all(isinstance(node, (ast.Import, ast.ImportFrom, ast.Expr, ast.Assign))
+               for node in tree.body), old
+
+
+def test_importing_the_kept_envs_path_registers_the_environment():
+    code = "import gymnasium, spacewar.envs; print('Spacewar-v0' in gymnasium.registry)"
+    out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True,
+                         check=True)
+    assert out.stdout.strip() == "True"

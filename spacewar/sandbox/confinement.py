@@ -214,16 +214,20 @@ def _copy_compiled_code(pairs, scratch, budget_bytes, budget_files):
     (numba loads its cache only from a writable directory), so a bot using the game's or the
     engine's kernels does not compile them.
 
-    ``pairs`` are ``(source directory, destination relative to scratch/numba)``. A directory
-    is copied whole or not at all, and only while the copies stay within the budgets (a
+    ``pairs`` are ``(source directory, destination relative to scratch/numba)``, or with a
+    third item the modules whose files to copy (numba names each file after its module: the
+    others are code of modules since moved or removed). A directory is copied whole or not at
+    all, and only while the copies stay within the budgets (a
     share of the scratch tmpfs's bytes and inodes: the bot's own files need the rest). Each
     file is written under a temporary name and renamed, data files before the index: a copy
     cut short by a full disk leaves no truncated file for numba to trip over (an index entry
     whose data file is missing only means a compile)."""
     used_bytes = used_files = 0
-    for source, relative in pairs or ():
+    for source, relative, *modules in pairs or ():
         try:
             names = sorted(os.listdir(source), key=lambda n: (n.endswith(".nbi"), n))
+            if modules:
+                names = [n for n in names if n.split(".", 1)[0] in modules[0]]
             # a tmpfs charges whole pages: count each file's size rounded up to one
             size = sum(-(-os.path.getsize(os.path.join(source, n)) // _PAGE) * _PAGE
                        for n in names)

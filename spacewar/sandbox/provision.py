@@ -29,26 +29,40 @@ def bot_environment(scratch):
 
 @functools.lru_cache(maxsize=None)
 def compiled_code_dirs():
-    """The directories of this checkout's compiled game and engine code, as
-    ``(source, destination relative to the bot's cache)`` pairs, the game's first (what a bot
-    most likely runs). A package's cache directory also holds the code compiled for every
-    other checkout of the same sources (numba names a subdirectory after each source
-    directory's absolute path): only this checkout's subdirectories are the bot's to copy."""
+    """The directories of this checkout's compiled game and engine code, as ``(source,
+    destination relative to the bot's cache, modules)``, the game's first (what a bot most
+    likely runs). A package's cache directory also holds the code compiled for every other
+    checkout of the same sources (numba names a subdirectory after each source directory's
+    absolute path): only this checkout's subdirectories are the bot's to copy. And a
+    subdirectory keeps the code of modules since moved or removed (numba names each file after
+    its module, ``core.step_all-120.py311.1.nbc``): ``modules`` names the ones the source
+    directory still has, the only files copied."""
     from engine.cache import cache_dir
 
     try:  # numba's own naming of the subdirectories (not public: a later numba may move it)
         from numba.core.caching import _CacheLocator
     except ImportError:
         return []  # nothing copied: a bot compiles what it uses
-    pairs = []
+    found = []
     for package in ("spacewar", "engine"):
         base = cache_dir(package)
         for source_dir in _package_dirs(os.path.join(PROJECT_ROOT, package)):
             sub = _CacheLocator.get_suitable_cache_subpath(os.path.join(source_dir, "x.py"))
-            if os.path.isdir(os.path.join(base, sub)):
-                pairs.append((os.path.join(base, sub),
-                              os.path.join(os.path.basename(base), sub)))
-    return pairs
+            modules = tuple(sorted(name[:-3] for name in os.listdir(source_dir)
+                                   if name.endswith(".py")))
+            try:
+                cached = os.listdir(os.path.join(base, sub))
+            except OSError:
+                continue
+            if any(cache_file_module(name) in modules for name in cached):
+                found.append((os.path.join(base, sub), os.path.join(os.path.basename(base), sub),
+                              modules))
+    return found
+
+
+def cache_file_module(name):
+    """The module a numba cache file was compiled from: its name up to the first dot."""
+    return name.split(".", 1)[0]
 
 
 def _package_dirs(root):

@@ -686,8 +686,27 @@ def test_a_bot_copies_only_this_checkout_s_compiled_code(tmp_path, monkeypatch):
         with open(os.path.join(directory, "learning.f-1.py311.nbi"), "wb") as f:
             f.write(b"index")
     pairs = provision.compiled_code_dirs.__wrapped__()
-    assert [source for source, _ in pairs] == [mine]
+    assert [source for source, _, _ in pairs] == [mine]
     assert pairs[0][1] == os.path.relpath(mine, str(tmp_path))
+    assert "learning" in pairs[0][2] and "rules" in pairs[0][2]  # the modules spacewar/ has
+
+
+def test_a_bot_copies_no_compiled_code_of_a_module_since_moved(tmp_path):
+    """numba names each cache file after its module: the files of a module that moved to a
+    subpackage (or was removed) stay in the old directory's cache, and are not copied."""
+    from spacewar.sandbox.confinement import _copy_compiled_code
+
+    source = tmp_path / "cache" / "spacewar_abc"
+    source.mkdir(parents=True)
+    for name in ("rules.f-1.py311.nbi", "rules.f-1.py311.1.nbc", "core.step-9.py311.nbi",
+                 "core.step-9.py311.1.nbc"):
+        (source / name).write_bytes(b"x")
+    scratch = tmp_path / "scratch"
+    scratch.mkdir()
+    _copy_compiled_code([(str(source), "pkg/spacewar_abc", ["rules", "protocol"])], str(scratch),
+                        budget_bytes=1 << 20, budget_files=100)
+    copied = sorted(p.name for p in scratch.rglob("*") if p.is_file())
+    assert copied == ["rules.f-1.py311.1.nbc", "rules.f-1.py311.nbi"]
 
 
 def test_compiled_code_is_copied_whole_within_its_budget_or_not_at_all(tmp_path, monkeypatch):
