@@ -29,6 +29,7 @@ KINDS = {
     "png": ("png",),
     "markdown": ("text",),
     "text": ("text",),
+    "html": ("text",),
 }
 
 _GIF = (b"GIF87a", b"GIF89a")
