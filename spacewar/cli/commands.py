@@ -7,6 +7,7 @@ from engine import compile_ahead
 from engine.atomic import check_output_path
 
 from spacewar.cli.options import limits_from, rules_from
+from spacewar.faults import printable
 
 
 def _describe_match(result, timing):
@@ -153,7 +154,18 @@ def _cmd_league(args):
 def _cmd_replay(args):
     from spacewar import replay as replay_io
 
+    if args.html:
+        from spacewar.view.html_page import check_page_path
+
+        check_page_path(args.html)  # before the replay is read: never over the replay itself
     data = replay_io.load(args.file)
+    if args.html:
+        from spacewar.view.player_page import write_player
+
+        summary = write_player(data, args.html)
+        print(f"wrote {printable(args.html)}: {summary['frames']} frames, "
+              f"{summary['bytes'] / 1e3:.0f} kB, replay {summary['signature']}")
+        return 0
     if args.check:
         ok, details = replay_io.check(data)
         r = details["replayed"]

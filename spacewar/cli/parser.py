@@ -40,11 +40,15 @@ def add_replay_command(sub):
     from spacewar.view.keys import replay_epilog
 
     r = sub.add_parser("replay", formatter_class=KeysHelpFormatter, epilog=replay_epilog(),
-                       help="check a replay, render it to a GIF or scrub it in a window")
+                       help="check a replay, render it to a GIF or a web page, or scrub it in a "
+                           "window")
     r.add_argument("file", help="the replay file (JSON)")
     what = r.add_mutually_exclusive_group(required=True)
     what.add_argument("--check", action="store_true", help="re-simulate and confirm the identical outcome")
     what.add_argument("--gif", metavar="OUT", help="render the match to an animated GIF")
+    what.add_argument("--html", metavar="OUT",
+                      help="write one self-contained web page that plays the match (play, "
+                           "pause, speeds, single frames, a scrub bar; no network)")
     what.add_argument("--view", action="store_true",
                       help="show it in a window: pause, step, slow motion, fast forward and "
                            "rewind, every frame re-simulated exactly (needs the [viz] extra)")

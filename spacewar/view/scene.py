@@ -148,7 +148,7 @@ def frame_snapshot(game, m=0):
 _SKY_CACHE = {}
 
 
-def _starfield(size):
+def starfield_primitives(size):
     """Faint fixed background stars, clear of the centre (so the central star stands alone)."""
     if size not in _SKY_CACHE:
         rng = random.Random(1962)
@@ -395,7 +395,7 @@ def scene(snapshot, size, effects=None, names=None, rounds=None, footer=(), bann
     prims = []
     frame = snapshot["frame"]
     if starfield:
-        prims.extend(_starfield(size))
+        prims.extend(starfield_primitives(size))
     if snapshot.get("star"):
         prims.extend(_star(frame, size))
     prims.extend(_torpedoes(snapshot, size))
