@@ -73,9 +73,16 @@ def signature_status(replay):
     if sig is None:
         return "unsigned"
     if not isinstance(sig, dict) or not isinstance(sig.get("key"), str) \
-            or not isinstance(sig.get("hmac_sha256"), str):
+            or not _is_hex_digest(sig.get("hmac_sha256")):
         return "forged"
     key = _key(create=False)
     if key is None or sig["key"] != _key_id(key):
         return "other key"
     return "verified" if hmac.compare_digest(sig["hmac_sha256"], _mac(key, replay)) else "forged"
+
+
+def _is_hex_digest(value):
+    """Whether ``value`` is a SHA-256 digest as ``_mac`` writes it: 64 lowercase hex digits
+    (anything else cannot be ours, and ``hmac.compare_digest`` refuses non-ASCII text)."""
+    return isinstance(value, str) and len(value) == 64 \
+        and all(c in "0123456789abcdef" for c in value)

@@ -32,6 +32,8 @@ import json
 
 from engine.atomic import atomic_write, check_output_path
 
+from spacewar.faults import printable
+
 #: the page's text encoding (declared in the page and used to hash its inline code)
 ENCODING = "utf-8"
 
@@ -39,6 +41,34 @@ ENCODING = "utf-8"
 def text(value):
     """``value`` as HTML text: ``& < > " '`` escaped, so it is shown, never parsed as markup."""
     return html.escape(str(value), quote=True)
+
+
+#: characters that print as nothing though they are letters or symbols (a blank Braille
+#: pattern, the Hangul fillers, the Mongolian vowel separator): shown escaped, so a name
+#: cannot push a score out of sight with them
+BLANK_LOOKING = frozenset("\u2800\u115f\u1160\u3164\uffa0\u180e")
+#: the most characters of a stranger's name shown where it shares a line with other facts
+NAME_CHARACTERS = 48
+FIRST_STRONG_ISOLATE, POP_DIRECTORY_ISOLATE = "\u2068", "\u2069"
+
+
+def visible(value):
+    """``value`` with every character that would not show as itself escaped: controls and
+    format characters (``spacewar.faults.printable``) and the blank-looking ones."""
+    return "".join(f"\\u{ord(c):04x}" if c in BLANK_LOOKING else c
+                   for c in printable(str(value)))
+
+
+def display_name(name, limit=NAME_CHARACTERS):
+    """A stranger's name as a page shows it among other text: control, format and
+    blank-looking characters escaped (``spacewar.faults.printable``), cut to ``limit``
+    characters (an ellipsis marks the cut), and isolated with U+2068 ... U+2069 (Unicode
+    Bidirectional Algorithm, UAX #9, "isolates"), so that right-to-left letters in it cannot
+    reorder the score or the other name beside it."""
+    shown = visible(name)
+    if len(shown) > limit:
+        shown = shown[:limit - 1] + "\u2026"
+    return FIRST_STRONG_ISOLATE + shown + POP_DIRECTORY_ISOLATE
 
 
 def source_hash(code):

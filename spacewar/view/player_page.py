@@ -22,10 +22,14 @@ compressed with zlib (deflate) and base64-encoded into the page, where the brows
 back and forward, a scrub bar to any frame with the round boundaries marked, the bots' names,
 the result and the replay's signature status (``spacewar.replay.signature_status``: verified,
 unsigned, signed with another key, forged), with keys: Space, ``,`` and ``.`` (or the arrow
-keys), ``[`` and ``]``, ``1``, Home and End. Every stranger's string (names, the result) is
-shown as text (``spacewar.faults.printable`` first, so control and direction-override
-characters are visible), never as markup: ``spacewar.view.html_page`` holds those rules and
-the page's Content-Security-Policy.
+keys), ``[`` and ``]``, ``1``, Home and End. The result shown is the one re-derived from the
+replay (``spacewar.replay.check``), with a warning where the file's recorded result differs:
+a file can claim any score, not make its frames play another. Every stranger's string (the
+names) is shown as text, never as markup, escaped, cut and isolated
+(``spacewar.view.html_page.display_name``: control, direction-override and blank-looking
+characters visible, right-to-left letters kept from reordering the score beside them);
+``spacewar.view.html_page`` holds those rules and the page's Content-Security-Policy. A
+replay of more than ``MAX_FRAMES`` frames is refused before it is simulated.
 
 ``Player`` is the notebook form: ``_repr_html_`` gives the page inside
 ``<iframe sandbox="allow-scripts" srcdoc=...>`` (a notebook drops a page's own policy and the
@@ -38,7 +42,6 @@ import math
 import os
 import zlib
 
-from spacewar.faults import printable
 from spacewar.view import html_page
 from spacewar.view.look import DEFAULT_NAMES
 from spacewar.view.scene import Effects, frame_snapshot, scene, starfield_primitives
@@ -46,13 +49,19 @@ from spacewar.view.scene import Effects, frame_snapshot, scene, starfield_primit
 SIZE = 720  # pixels of the scene the primitives are laid out for (the window's default)
 QUANTUM = 8  # coordinates are stored in 1/QUANTUM pixel steps
 FPS = 60  # game frames a second at 1x (the 1962 game's pace)
+#: the most frames a page holds (a replay is re-simulated and laid out whole: about 200 bytes
+#: a frame in the page, 0.2 ms a frame to make; the longest real matches here are 60,001)
+MAX_FRAMES = 250_001
+#: the most characters of a name kept for its tooltip
+FULL_NAME_CHARACTERS = 1000
 #: primitive kinds in the order of their codes in the page's data
 KINDS = ("dot", "ring", "poly", "fill", "line", "text")
 ALIGNS = {"left": 0, "centre": 1, "right": 2}
 #: what the page says of each signature status
 SIGNATURE_TEXT = {
     "verified": "signed with this computer's key: the bots and fault record are as recorded",
-    "unsigned": "unsigned: the match replays, but who played it cannot be verified",
+    "unsigned": "unsigned: the play and the score are the replay's own, but who played and "
+                "the fault record cannot be verified",
     "other key": "signed with another key: cannot be verified here",
     "forged": "FORGED: its signature does not match its content",
 }
@@ -121,15 +130,28 @@ def decode_primitive(code, colours, texts):
 
 
 def shown_names(replay):
-    """The two bots' names as the page shows them: escaped (control and format characters
-    made visible, ``spacewar.faults.printable``)."""
-    names = replay.get("bots") or replay.get("result", {}).get("bots") or DEFAULT_NAMES
-    return [printable(str(n)) for n in names]
+    """The two bots' names as the page shows them: escaped, cut to ``NAME_CHARACTERS`` and
+    isolated (``spacewar.view.html_page.display_name``)."""
+    return [html_page.display_name(n) for n in _names(replay)]
 
 
-def result_text(replay, names):
-    """One line saying how the match ended, from the replay's recorded result."""
-    result = replay.get("result") or {}
+def _names(replay):
+    return replay.get("bots") or replay.get("result", {}).get("bots") or DEFAULT_NAMES
+
+
+def replayed_result(replay):
+    """``(result, mismatched fields)``: the result re-derived from the replay alone
+    (``spacewar.replay.check``: score, winner, forfeits from the recorded faults) and the
+    fields where the file's recorded result says otherwise. The page shows the re-derived
+    one: a file can claim any result, but not make its frames play another."""
+    from spacewar.replay import check
+
+    _, details = check(replay)
+    return details["replayed"], sorted(details["mismatches"])
+
+
+def result_text(result, names):
+    """One line saying how the match ended."""
     score = result.get("score") or [0, 0]
     forfeits = result.get("forfeits") or [False, False]
     seat = result.get("winner_seat")
@@ -142,33 +164,65 @@ def result_text(replay, names):
     return f"a draw ({line})"
 
 
-def frames(replay, size=SIZE, on_snapshot=None):
+def frames(replay, size=SIZE, on_snapshot=None, sink=None):
     """Re-simulate ``replay`` and lay out every frame: ``(encoded frames, tables, round
     starts)``: each frame's primitives (``encode_primitive``; the star field left out, it is
-    the same every frame), the colour and string tables, the first frame of each round. ``on_snapshot(index, snapshot, prims)`` (optional) sees each
-    frame's ``frame_snapshot`` and its primitives as drawn, for tests."""
+    the same every frame), the colour and string tables, the first frame of each round.
+    With ``sink`` (a callable taking each frame's encoding) the frames go there as they come
+    and the list returned is empty, so memory does not grow with the match.
+    ``on_snapshot(index, snapshot, prims)`` (optional) sees each frame's ``frame_snapshot``
+    and its primitives as drawn, for tests."""
     from spacewar.replay import simulate
 
+    if replay["frames"] + 1 > MAX_FRAMES:
+        from spacewar.replay import ReplayError
+
+        raise ReplayError(f"the replay has {replay['frames']} frames: a player page holds at "
+                          f"most {MAX_FRAMES - 1} (about {MAX_FRAMES * 200 // 10**6} MB)")
     names = shown_names(replay)
     rounds = replay.get("rounds")
     tables = _Tables()
     effects = Effects()
     encoded, round_starts = [], []
-    last_round = {"value": None}
+    state = {"round": None, "count": 0}
 
     def on_frame(game):
         snap = frame_snapshot(game)
         effects.update(snap)
-        if snap["round"] != last_round["value"] and not snap.get("over"):
-            round_starts.append(len(encoded))
-            last_round["value"] = snap["round"]
+        if snap["round"] != state["round"] and not snap.get("over"):
+            round_starts.append(state["count"])
+            state["round"] = snap["round"]
         prims = scene(snap, size, effects=effects, names=names, rounds=rounds, starfield=False)
         if on_snapshot is not None:
-            on_snapshot(len(encoded), snap, prims)
-        encoded.append([encode_primitive(p, tables) for p in prims])
+            on_snapshot(state["count"], snap, prims)
+        frame = [encode_primitive(p, tables) for p in prims]
+        if sink is None:
+            encoded.append(frame)
+        else:
+            sink(frame)
+        state["count"] += 1
 
     simulate(replay, on_frame)
     return encoded, tables, round_starts
+
+
+class _Packer:
+    """The frames' JSON list, deflated as it comes (``zlib.compressobj``)."""
+
+    def __init__(self):
+        self.squeeze = zlib.compressobj(9)
+        self.parts = [self.squeeze.compress(b"[")]
+        self.count = 0
+
+    def add(self, frame):
+        text = ("," if self.count else "") + json.dumps(frame, separators=(",", ":"))
+        self.parts.append(self.squeeze.compress(text.encode("ascii")))
+        self.count += 1
+
+    def finish(self):
+        self.parts.append(self.squeeze.compress(b"]"))
+        self.parts.append(self.squeeze.flush())
+        return b"".join(self.parts)
 
 
 def document_data(replay, size=SIZE):
@@ -176,14 +230,20 @@ def document_data(replay, size=SIZE):
     from spacewar.replay import signature_status
 
     names = shown_names(replay)
-    encoded, tables, round_starts = frames(replay, size)
-    packed = zlib.compress(json.dumps(encoded, separators=(",", ":")).encode("ascii"), 9)
+    packer = _Packer()
+    _, tables, round_starts = frames(replay, size, sink=packer.add)
+    packed = packer.finish()
     status = signature_status(replay)
+    result, differs = replayed_result(replay)
     starfield = [encode_primitive(p, tables) for p in starfield_primitives(size)]
     return {
         "format": "spacewar-player", "version": 1, "size": size, "quantum": QUANTUM,
-        "fps": FPS, "count": len(encoded), "names": names,
-        "result": result_text(replay, names), "signature": status,
+        "fps": FPS, "count": packer.count, "names": names,
+        "full_names": [html_page.visible(n)[:FULL_NAME_CHARACTERS] for n in _names(replay)],
+        "result": result_text(result, names),
+        "warning": (f"the file's recorded result differs from its replay ({', '.join(differs)})"
+                    if differs else ""),
+        "signature": status,
         "signature_text": SIGNATURE_TEXT[status], "round_starts": round_starts,
         "rounds": replay.get("rounds"), "seed": str(replay.get("seed")),
         "mode": (replay.get("rules") or {}).get("mode", "classic"),
@@ -200,7 +260,7 @@ def page_html(replay, title=None, size=SIZE):
     body = (
         '<main class="player">'
         '<header><h1 id="title"></h1><p id="result"></p>'
-        '<p id="signature"></p></header>'
+        '<p id="signature"></p><p id="warning"></p></header>'
         '<div class="stage"><canvas id="scope" width="1" height="1"></canvas></div>'
         '<div class="bar"><input id="scrub" type="range" min="0" max="0" value="0" '
         'aria-label="frame"><div id="marks"></div></div>'

@@ -10,7 +10,7 @@ import pytest
 
 from spacewar import replay as replay_io
 from spacewar.arena.match import play_match
-from spacewar.faults import printable
+from spacewar.view.html_page import display_name, visible
 from spacewar.view import player_page
 from spacewar.view.look import SHIP_COLOURS
 from spacewar.view.player_page import QUANTUM, SIZE, Player
@@ -238,8 +238,9 @@ def test_hostile_names_are_shown_as_text(open_page, recorded, tmp_path):
     visit = opened(open_page, tmp_path / "hostile.html")
     page = visit.page
     visit.assert_quiet()
-    shown = [printable(n) for n in HOSTILE[:2]]
+    shown = [display_name(n) for n in HOSTILE[:2]]
     assert page.text_content("#title") == f"{shown[0]} vs {shown[1]}"
+    assert page.get_attribute("#title", "title") == f"{visible(HOSTILE[0])} vs {visible(HOSTILE[1])}"
     assert page.evaluate("window.__owned") is None
     assert page.evaluate("document.querySelectorAll('img, b').length") == 0
     assert page.evaluate("document.scripts.length") == 2  # its data block and its code

@@ -12,7 +12,6 @@ import pytest
 from spacewar import replay as replay_io
 from spacewar.arena.match import play_match
 from spacewar.cli import main
-from spacewar.faults import printable
 from spacewar.view import html_page, player_page
 from spacewar.view.player_page import QUANTUM, Player
 
@@ -178,9 +177,52 @@ def test_a_hostile_name_is_text_in_the_page_never_markup(match, name):
         [(t, sorted(a)) for t, a in clean.elements]
     assert not any(k.startswith("on") for _, a in page.elements for k in a)
     data = page_data(document)
-    assert data["names"][0] == printable(name)  # escaped: control and format chars visible
+    assert data["names"][0] == html_page.display_name(name)  # escaped, cut, isolated
+    assert data["full_names"][0] == html_page.visible(name)[:player_page.FULL_NAME_CHARACTERS]
     assert "\u202e" not in document and "</script><script>alert" not in document
     assert data["signature"] == "unsigned"
+
+
+def test_a_name_cannot_reorder_hide_or_push_away_the_score(match):
+    """Right-to-left letters reversed the score beside a name; blank-looking letters pushed
+    it out of sight (both found by a red team): a name is isolated, cut and escaped."""
+    _, replay = match
+    rtl, pad = "Evil\u05d5", "EVIL  3" + "\u2800" * 120
+    data = page_data(player_page.page_html(_with_names(replay, [rtl, pad])))
+    first, second = data["names"]
+    assert first == "\u2068" + rtl + "\u2069"  # isolated: it cannot reorder what is beside it
+    assert second.startswith("\u2068EVIL  3\\u2800") and second.endswith("\u2026\u2069")
+    assert len(second) == html_page.NAME_CHARACTERS + 2
+    assert "\u2800" not in json.dumps(data, ensure_ascii=False)
+
+
+def test_the_result_shown_is_the_replays_own_whatever_the_file_claims(match):
+    _, replay = match
+    claims = _with_names(replay, ["chaser", "sniper"])
+    claims["result"]["score"] = [9, 0]
+    claims["result"]["winner_seat"] = 0
+    claims["result"]["winner"] = "chaser"
+    data = page_data(player_page.page_html(claims))
+    honest = page_data(player_page.page_html(_with_names(replay, ["chaser", "sniper"])))
+    assert data["result"] == honest["result"] and "9" not in data["result"]
+    assert data["warning"].startswith("the file's recorded result differs from its replay")
+    assert "score" in data["warning"] and honest["warning"] == ""
+
+
+def test_a_malformed_signature_is_forged_not_a_crash(match):
+    _, replay = match
+    odd = json.loads(json.dumps(replay))
+    odd.pop(replay_io.DIGEST_FIELD)
+    odd[replay_io.SIGNATURE_FIELD]["hmac_sha256"] = "\u00e9"  # compare_digest refuses it
+    assert replay_io.signature_status(odd) == "forged"
+    assert page_data(player_page.page_html(odd))["signature"] == "forged"
+
+
+def test_a_replay_too_long_for_a_page_is_refused_before_it_is_simulated(match, monkeypatch):
+    _, replay = match
+    monkeypatch.setattr(player_page, "MAX_FRAMES", replay["frames"])
+    with pytest.raises(replay_io.ReplayError, match="a player page holds at most"):
+        player_page.page_html(replay)
 
 
 @pytest.mark.parametrize("how, status", [("drop", "unsigned"), ("keep", "forged"),

@@ -147,8 +147,9 @@
 
   function header() {
     el("title").textContent = data.names[0] + " vs " + data.names[1];
-    el("title").title = data.names[0] + " vs " + data.names[1];
+    el("title").title = data.full_names.join(" vs ");
     el("result").textContent = data.result;
+    el("warning").textContent = data.warning;
     const sig = el("signature");
     sig.textContent = "replay " + data.signature_text;
     sig.className = data.signature.replace(" ", "-");
