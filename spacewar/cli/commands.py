@@ -98,7 +98,7 @@ def _cmd_tournament(args):
         bots, games=args.games, seed=args.seed, rounds=args.rounds, rules=rules_from(args),
         workers=args.workers, progress=not args.no_progress and not args.json,
         limits=limits_from(args), max_faults=args.max_faults, isolation=args.isolation,
-        scheduler=args.scheduler)
+        scheduler=args.scheduler, bootstrap=args.bootstrap)
     if args.json:
         print(json.dumps(report, sort_keys=True, indent=2))
     else:

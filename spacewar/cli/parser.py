@@ -93,6 +93,9 @@ def build_parser():
                    help="run the matches on a Dask cluster: its scheduler's address, or 'local' "
                         "for a LocalCluster of this machine (default: $DASK_SCHEDULER_ADDRESS, "
                         "else local processes); needs the [cluster] extra")
+    t.add_argument("--bootstrap", type=non_negative_int, default=200,
+                   help="bootstrap resamples of the matches for the ratings' 95%% intervals "
+                        "(seeded by --seed; 0: none)")
     add_rules_options(t)
     add_fault_options(t)
 
