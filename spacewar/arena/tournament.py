@@ -16,6 +16,10 @@ matches (default 200, as a league's), drawn with replacement by a generator seed
 tournament's seed (``bootstrap_rng``), so the same seed gives the same intervals. The table's
 ``elo`` stays the full-matrix fit (``bradley_terry_elo``) and its order is by it; the
 interval's ends are ``elo_low`` and ``elo_high``.
+
+``replays``: a directory where each match's replay is kept (``spacewar.arena.kept_replays``:
+brought back from the worker processes or the cluster, saved under a name of its place in the
+schedule and its seed); the report is the same with or without.
 """
 import itertools
 import os
@@ -23,6 +27,7 @@ import os
 import numpy as np
 
 from spacewar.faults import printable
+from spacewar.arena import kept_replays
 # the jobs' names, public here too (a tournament's work is cut by them)
 from spacewar.arena.jobs import (batch_files_of, group_jobs, make_jobs, match_record, warm_up_game)  # noqa: F401
 from spacewar.arena.match import DEFAULT_BUDGET, DEFAULT_MAX_FAULTS
@@ -57,14 +62,16 @@ def bootstrap_rng(seed):
 
 def run_tournament(bots, games=10, seed=1, rounds=3, rules=None, workers=None, progress=True,
                    budget=DEFAULT_BUDGET, max_faults=DEFAULT_MAX_FAULTS, isolation="auto",
-                   limits=None, scheduler=None, bootstrap=DEFAULT_BOOTSTRAP):
+                   limits=None, scheduler=None, bootstrap=DEFAULT_BOOTSTRAP, replays=None):
     """Play the round robin; return ``(report, stats)``: the table and every match result
     (plain data), and the frames played and match seconds. ``limits`` (a
     ``spacewar.sandbox.limits.Limits``) sets every budget of the bots; ``budget`` alone the per-action
     one. ``scheduler``: a Dask scheduler's address, or ``"local"`` for a LocalCluster of this
     machine (default: the ``DASK_SCHEDULER_ADDRESS`` variable, else local processes); the
     report is the same either way (``spacewar.arena.cluster``). ``bootstrap``: resamples for
-    the ratings' 95% intervals (0: none, the interval is the rating)."""
+    the ratings' 95% intervals (0: none, the interval is the rating). ``replays``: a
+    directory to keep every match's replay in (``spacewar.arena.kept_replays``; checked and
+    made before any match is played); the report is the same with or without."""
     bots = list(bots)
     if len(bots) < 2:
         raise ValueError(f"a tournament needs at least two bots, got {bots!r}")
@@ -84,14 +91,21 @@ def run_tournament(bots, games=10, seed=1, rounds=3, rules=None, workers=None, p
     limits = Limits(budget=budget) if limits is None else limits
     if isinstance(bootstrap, bool) or not isinstance(bootstrap, int) or bootstrap < 0:
         raise ValueError(f"bootstrap must be an int >= 0, got {bootstrap!r}")
-    jobs = make_jobs(schedule(bots, games, seed), rounds, rules, limits, max_faults, isolation,
-                     batch_files_of(bots))
+    planned = schedule(bots, games, seed)
+    names = kept_replays.tournament_names(planned)
+    if replays is not None:
+        replays = kept_replays.prepare(replays)
+        kept_replays.check_paths(replays, names)
+    jobs = make_jobs(planned, rounds, rules, limits, max_faults, isolation, batch_files_of(bots))
     bar = progress_bar(sum(len(job[0]) for job in jobs), progress)
     try:
         with MatchRunner(bots, rules, workers, scheduler) as runner:
-            outcomes = runner.play(jobs, bar.update)
+            outcomes = (runner.play(jobs, bar.update) if replays is None else
+                        runner.play(jobs, bar.update, record=True))
     finally:
         bar.close()
+    if replays is not None:
+        kept_replays.save_all(replays, names, [replay for _, _, replay in outcomes])
     return _report(bots, games, seed, rounds, rules, outcomes, bootstrap)
 
 
