@@ -203,12 +203,13 @@ def format_standings(results):
                      f"{row['faults']:>8}"
                      f"{row['mu']:>8.2f}{row['sigma']:>7.2f}{row['ordinal']:>9.2f}"
                      f"{row['elo']:>7.0f}  {row['elo_low']:.0f}-{row['elo_high']:.0f}")
-    lines += [_resumed_note(entry) for entry in results.get("resumed_from", [])]
+    lines += [resumed_note(entry) for entry in results.get("resumed_from", [])]
     return "\n".join(lines)
 
 
-def _resumed_note(entry):
-    """The line under the table for a resume from an unverified file."""
+def resumed_note(entry):
+    """The line under the table (and on the league's pages) for a resume from an unverified
+    file."""
     kind = {"unsigned": "an unsigned", "other key": "another key's",
             "forged": "a forged (signature not matching)"}[entry["signature"]]
     return (f"NOTE: resumed with {TRUST_OPTION} from {kind} results file: its first "
