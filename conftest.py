@@ -16,6 +16,8 @@ core (``pytest_cmdline_main`` below: ``-n auto`` unless ``-n`` is given; ``-n 0`
   budgets, hang detection, tests that start a process per core) run after all the others, on
   one worker, while no other test runs; before them each worker is given a test module at a
   time, whole, the long ones first (``ModulesThenSerial``).
+- **The browser fixtures** (``chromium``, ``open_page``: tests/browser.py) loaded as a plugin,
+  so that any test module can use them; each worker launches a browser of its own.
 
 This file is the repository's, not the suite's rules (tests/conftest.py, which
 tests/test_skip_policy.py runs in scratch directories of its own, without this file).
@@ -26,6 +28,9 @@ import tempfile
 import time
 
 import pytest
+
+#: the fixtures of the tests run in a headless Chromium (tests/browser.py)
+pytest_plugins = ("tests.browser",)
 
 #: the marker of the tests that run alone (pyproject.toml registers it)
 SERIAL = "serial"
