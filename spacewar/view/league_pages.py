@@ -343,6 +343,7 @@ def _replays(directory, model, replays, writer, summary):
             continue
         page_link = None
         if writer is not None:
+            os.makedirs(os.path.join(directory, MATCHES_DIR), exist_ok=True)
             out = os.path.join(directory, MATCHES_DIR, m["name"] + ".html")
             writer(replay, out)
             summary["match_pages"] += 1
@@ -394,8 +395,7 @@ def write_pages(directory, results, replays=None, player=True):
     writer = player_writer() if player else None
     summary = {"index": os.path.join(directory, "index.html"), "bot_pages": 0,
                "match_pages": 0, "replays_missing": 0, "replays_refused": 0, "bytes": 0}
-    for sub in (BOTS_DIR,) + ((MATCHES_DIR,) if writer is not None and replays else ()):
-        os.makedirs(os.path.join(directory, sub), exist_ok=True)
+    os.makedirs(os.path.join(directory, BOTS_DIR), exist_ok=True)
     links, faults = _replays(directory, model, replays, writer, summary)
     bots = model["bots"]
     pages = {b: f"{BOTS_DIR}/{bot_page(i)}" for i, b in enumerate(bots)}
