@@ -105,11 +105,13 @@ def _write_pages(args, results, pages, replays):
     from spacewar.view.league_pages import write_pages
 
     summary = write_pages(pages, results, replays)
-    missing = (f"; {summary['replays_missing'] + summary['replays_refused']} matches without "
-               "their replay" if summary["replays_missing"] + summary["replays_refused"] else "")
+    without = summary["replays_missing"] + summary["replays_refused"]
+    notes = (f"; {without} matches without their replay" if without else "") + (
+        f"; {summary['player_refused']} replays too long for a player page"
+        if summary["player_refused"] else "")
     print(f"wrote {summary['index']}: {summary['bot_pages']} bot pages, "
           f"{summary['match_pages']} match pages, {summary['bytes'] / 1e6:.1f} MB in "
-          f"{summary['seconds']:.1f} s{missing}", file=sys.stderr if args.json else sys.stdout)
+          f"{summary['seconds']:.1f} s{notes}", file=sys.stderr if args.json else sys.stdout)
 
 
 def _cmd_tournament(args):

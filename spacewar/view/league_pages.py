@@ -345,10 +345,14 @@ def _replays(directory, model, replays, writer, summary):
         if writer is not None:
             os.makedirs(os.path.join(directory, MATCHES_DIR), exist_ok=True)
             out = os.path.join(directory, MATCHES_DIR, m["name"] + ".html")
-            writer(replay, out)
-            summary["match_pages"] += 1
-            summary["bytes"] += os.path.getsize(out)
-            page_link = f"{MATCHES_DIR}/{m['name']}.html"
+            try:
+                writer(replay, out)
+            except ReplayError:  # one the player refuses (too long to hold): no page
+                summary["player_refused"] += 1
+            else:
+                summary["match_pages"] += 1
+                summary["bytes"] += os.path.getsize(out)
+                page_link = f"{MATCHES_DIR}/{m['name']}.html"
         links[m["name"]] = (page_link, _link(path, directory))
         for seat, bot in enumerate((m["p1"], m["p2"])):
             examples = replay["result"]["faults"][seat].get("examples") or []
@@ -388,13 +392,15 @@ def write_pages(directory, results, replays=None, player=True):
     directory, or None) and to its player page, written when ``player`` and the player
     module is there. Returns a summary: ``index`` (its path), ``bot_pages``,
     ``match_pages``, ``replays_missing``, ``replays_refused`` (unreadable, or another
-    match's), ``bytes`` (of every page written) and ``seconds``."""
+    match's), ``player_refused`` (replays the player cannot hold: linked, with no page),
+    ``bytes`` (of every page written) and ``seconds``."""
     start = time.perf_counter()
     directory = check_pages_dir(directory)
     model = run_model(results)
     writer = player_writer() if player else None
     summary = {"index": os.path.join(directory, "index.html"), "bot_pages": 0,
-               "match_pages": 0, "replays_missing": 0, "replays_refused": 0, "bytes": 0}
+               "match_pages": 0, "replays_missing": 0, "replays_refused": 0,
+               "player_refused": 0, "bytes": 0}
     os.makedirs(os.path.join(directory, BOTS_DIR), exist_ok=True)
     links, faults = _replays(directory, model, replays, writer, summary)
     bots = model["bots"]
@@ -402,6 +408,10 @@ def write_pages(directory, results, replays=None, player=True):
     record = head_to_head(model["matches"])
     rank = {row["bot"]: r for r, row in enumerate(model["table"], 1)}
     order = [row["bot"] for row in model["table"]]
+    played = {b: [] for b in bots}
+    for m in model["matches"]:
+        played[m["p1"]].append(m)
+        played[m["p2"]].append(m)
 
     code = (package_text("league.js"), package_text("league.css"))
 
@@ -410,7 +420,7 @@ def write_pages(directory, results, replays=None, player=True):
         summary["bytes"] += len(document.encode("utf-8"))
 
     for i, bot in enumerate(bots):
-        mine = [m for m in model["matches"] if bot in (m["p1"], m["p2"])]
+        mine = played[bot]
         opponents = [b for b in order if (bot, b) in record]
         h2h_rows = "".join(
             f'<tr><td class="rank">{rank[b]}</td><td class="bot">{_name(b, "../" + pages[b])}'

@@ -449,6 +449,36 @@ def test_hostile_names_are_only_ever_text(tmp_path):
     assert {"h3", "h8"} <= shares  # a quarter and three quarters, rounded half up
 
 
+def test_a_name_that_is_not_utf_8_is_shown_and_kept_escaped(tmp_path):
+    """A file name's undecodable bytes come as lone surrogates, which no page can hold: the
+    name is shown, and kept in the data block, with them escaped."""
+    odd = "bots/caf\udce9.py:Bot"
+    report = fabricated_report(["idle", odd])
+    league_pages.write_pages(tmp_path / "pages", report)
+    index = Page(tmp_path / "pages" / "index.html")
+    assert printable(odd) == "bots/caf\\udce9.py:Bot"
+    assert printable(odd) in {s.text() for s in index.root.find_all("span", "name")}
+    assert index.data()["bots"] == ["idle", printable(odd)]
+
+
+def test_a_replay_the_player_refuses_is_linked_without_a_page(tmp_path, monkeypatch):
+    from spacewar.replay import ReplayError
+
+    report, _ = run_tournament(["idle", "random"], workers=1, replays=tmp_path / "kept",
+                               **QUICK)
+
+    def refusing(replay, out_path):
+        raise ReplayError("too long for a page")
+
+    monkeypatch.setattr(league_pages, "player_writer", lambda: refusing)
+    summary = league_pages.write_pages(tmp_path / "pages", report, tmp_path / "kept")
+    assert summary["player_refused"] == 2 and summary["match_pages"] == 0
+    data = Page(tmp_path / "pages" / "index.html").data()
+    assert all(m["page"] is None and m["replay"] for m in data["matches"])
+    for path in all_pages(tmp_path / "pages"):
+        links_resolve(path)
+
+
 def test_a_hostile_bot_played_for_real_stays_text_on_every_page(tmp_path):
     folder = tmp_path / '"><img src=x onerror=alert(1)>' / "a</script><script>alert(1)<"
     folder.mkdir(parents=True)
