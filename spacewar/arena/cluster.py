@@ -130,9 +130,10 @@ def _named_by_seat(result, pair):
     return result
 
 
-def play_chunk(task, fingerprint):
-    """A task: the outcomes of each job of ``task = (jobs, files)`` (``jobs.play_job``),
-    with the client's bot names; ``files`` holds the bots from files those jobs play."""
+def play_chunk(task, fingerprint, record=False):
+    """A task: the outcomes of each job of ``task = (jobs, files)`` (``jobs.play_job``, with
+    each match's replay when ``record``), with the client's bot names; ``files`` holds the
+    bots from files those jobs play."""
     cluster.check_code(fingerprint)
     from spacewar.arena.jobs import play_job
 
@@ -143,9 +144,12 @@ def play_chunk(task, fingerprint):
             rest = list(rest)
             rest[-1] = frozenset(local.get(s, s) for s in rest[-1])  # batch_files
             mine = [(local.get(p1, p1), local.get(p2, p2), seed) for p1, p2, seed in matches]
-            outcomes = play_job((mine, together, *rest))
-            for (result, _), (p1, p2, _) in zip(outcomes, matches, strict=True):
-                _named_by_seat(result, (p1, p2))
+            outcomes = play_job((mine, together, *rest), record)
+            for outcome, (p1, p2, _) in zip(outcomes, matches, strict=True):
+                _named_by_seat(outcome[0], (p1, p2))
+                if record:  # the replay names its bots and holds its result as the client's
+                    outcome[2]["bots"] = list(outcome[0]["bots"])
+                    outcome[2]["result"] = outcome[0]
             out.append(outcomes)
     return out
 
@@ -174,11 +178,13 @@ def connect(address, bots):
     return _GameConnection(address, bots)
 
 
-def play_jobs(connection, jobs, progress):
+def play_jobs(connection, jobs, progress, record=False):
     """Every job's outcomes, in job order, played on the cluster of ``connection``
-    (``connect``); ``progress(matches)`` as tasks complete."""
+    (``connect``); ``progress(matches)`` as tasks complete. With ``record`` each outcome
+    carries its match's replay too (``jobs.play_job``), brought back from the worker."""
     tasks = [_task(c, connection.files) for c in cluster.chunk(jobs, connection.connection.workers())]
+    common = (cluster.code_fingerprint(),) + ((True,) if record else ())
     results = cluster.run_chunks(
-        connection.connection, play_chunk, tasks, common=(cluster.code_fingerprint(),),
+        connection.connection, play_chunk, tasks, common=common,
         progress=lambda task: progress(sum(len(job[0]) for job in task[0])))
     return [outcome for chunk in results for outcomes in chunk for outcome in outcomes]

@@ -4,26 +4,33 @@ sends them; ``spacewar.arena.cluster`` ships them to the cluster).
 
 A job is plain data, ``(matches, together, rounds, rules_dict, limits, max_faults,
 isolation, batch_files)``: one match, or every match of a pairing with a batch bot, played
-together in one game (``spacewar.arena.batch_match``).
+together in one game (``spacewar.arena.batch_match``). Whether the matches' replays come back
+too is asked of the run (``play_job(job, record=True)``), not written into the job: a job is
+what to play, the same whichever way it is played.
 """
 from spacewar.arena.match import play_match
 from spacewar.rules import Rules
 
 
-def play_job(job):
+def play_job(job, record=False):
     """A job's outcomes ``[(result, timing), ...]``: one match, or every match of a pairing
-    with a batch bot, played together (``spacewar.arena.batch_match``)."""
+    with a batch bot, played together (``spacewar.arena.batch_match``). With ``record``,
+    ``[(result, timing, replay), ...]``: each match's replay dict (``spacewar.replay``) comes
+    back too, the results the same as without (recording only keeps what was played)."""
     matches, together, rounds, rules_dict, limits, max_faults, isolation, batch_files = job
     rules = Rules.from_dict(rules_dict)
     if together:
         from spacewar.arena.batch_match import play_matches
 
-        return play_matches(matches, rounds=rounds, rules=rules, limits=limits,
-                            max_faults=max_faults, batch_files=batch_files)
+        outcomes = play_matches(matches, rounds=rounds, rules=rules, limits=limits,
+                                max_faults=max_faults, batch_files=batch_files, record=record)
+        return [(result, timing, replay) for result, replay, timing in outcomes] if record \
+            else outcomes
     (p1, p2, match_seed), = matches
-    result, _, timing = play_match(p1, p2, seed=match_seed, rounds=rounds, rules=rules,
-                                   limits=limits, max_faults=max_faults, isolation=isolation)
-    return [(result, timing)]
+    result, replay, timing = play_match(p1, p2, seed=match_seed, rounds=rounds, rules=rules,
+                                        limits=limits, max_faults=max_faults,
+                                        isolation=isolation, record=record)
+    return [(result, timing, replay)] if record else [(result, timing)]
 
 
 def batch_files_of(bots):

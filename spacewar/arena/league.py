@@ -31,6 +31,11 @@ the ones the seed gives, and the ratings are recomputed from all stored matches,
 interrupted and resumed ends with the same file as one run straight through. An interruption
 loses at most the matches of the round that was being played.
 
+``replays``: a directory where each match's replay is kept (``spacewar.arena.kept_replays``:
+brought back from the worker processes or the cluster, saved after its round under a name of
+the round, the match's place in it and its seed, before the results file); the results are the
+same with or without, and a resume keeps the replays of the rounds it plays.
+
 The file is signed with this user's key (``spacewar.replay.sign``: an HMAC-SHA256 with the
 replay-signing key), and checked record by record before a resume uses any of it (every
 field's type and range, the players and seeds the schedule gives, a winner consistent with
@@ -52,6 +57,7 @@ from spacewar.sandbox.limits import Limits
 from spacewar.arena.jobs import batch_files_of, make_jobs, match_record
 from spacewar.arena.ratings import bradley_terry_intervals, match_outcome, openskill_ratings
 from spacewar.arena.runner import MatchRunner, progress_bar
+from spacewar.arena import kept_replays
 
 
 def _positive_int(name, value):
@@ -99,7 +105,7 @@ def standings(bots, matches, byes, bootstrap, seed):
 def run_league(bots, rounds, out, games=2, pairing="swiss", seed=1, match_rounds=3, rules=None,
                workers=None, progress=True, budget=DEFAULT_BUDGET, max_faults=DEFAULT_MAX_FAULTS,
                isolation="auto", limits=None, scheduler=None, bootstrap=200, on_round=None,
-               trust_results=False):
+               trust_results=False, replays=None):
     """Play a league to ``rounds`` rounds, saving to the JSON file ``out`` after each; resume
     from ``out`` when it holds completed rounds of the same league. Returns the results (the
     file's content). ``on_round(results)`` is called after each round is saved. Matches run as
@@ -108,7 +114,11 @@ def run_league(bots, rounds, out, games=2, pairing="swiss", seed=1, match_rounds
     The file is signed with this user's key; a file to resume must be verified, unless
     ``trust_results``: then an unsigned one, one signed with another key or a forged one is
     resumed all the same (after its record-by-record checks, which always hold), and the
-    results' ``resumed_from`` and the table say so (``load_results``)."""
+    results' ``resumed_from`` and the table say so (``load_results``).
+
+    ``replays``: a directory to keep the replay of every match this run plays
+    (``spacewar.arena.kept_replays``; the directory is checked and made before any match,
+    each round's file names before its matches); the results are the same with or without."""
     from engine.atomic import check_output_path
 
     from spacewar.bots import check_one_spelling_each, locate
@@ -137,6 +147,8 @@ def run_league(bots, rounds, out, games=2, pairing="swiss", seed=1, match_rounds
     # an existing file must be this league's, read within its league's bound by load_results
     out = check_output_path(out)
     done, resumed_from = load_results(out, config, trust_results, rounds)
+    if replays is not None:
+        replays = kept_replays.prepare(replays)
     if len(done) > rounds:
         raise LeagueFileError(f"{out!r} already holds {len(done)} rounds of this league, more "
                               f"than rounds={rounds}: ask for at least {len(done)}")
@@ -148,11 +160,18 @@ def run_league(bots, rounds, out, games=2, pairing="swiss", seed=1, match_rounds
             while len(done) < rounds:
                 index = len(done)
                 pairs, bye = pair_round(config, index, *state_after(config, done))
-                jobs = make_jobs(round_schedule(config, index, pairs), match_rounds, rules,
-                                 limits, max_faults, isolation, batch_files)
-                outcomes = runner.play(jobs, bar.update)
+                planned = round_schedule(config, index, pairs)
+                names = kept_replays.league_round_names(index + 1, planned)
+                if replays is not None:
+                    kept_replays.check_paths(replays, names)
+                jobs = make_jobs(planned, match_rounds, rules, limits, max_faults, isolation,
+                                 batch_files)
+                outcomes = (runner.play(jobs, bar.update) if replays is None else
+                            runner.play(jobs, bar.update, record=True))
+                if replays is not None:
+                    kept_replays.save_all(replays, names, [o[2] for o in outcomes])
                 done = done + [{"round": index + 1, "pairs": [list(p) for p in pairs],
-                                "bye": bye, "matches": [match_record(r) for r, _ in outcomes]}]
+                                "bye": bye, "matches": [match_record(o[0]) for o in outcomes]}]
                 results = results_document(config, done, _table(config, done, 0), resumed_from)
                 save_results(out, results)
                 if on_round is not None:
@@ -184,12 +203,13 @@ def format_standings(results):
                      f"{row['faults']:>8}"
                      f"{row['mu']:>8.2f}{row['sigma']:>7.2f}{row['ordinal']:>9.2f}"
                      f"{row['elo']:>7.0f}  {row['elo_low']:.0f}-{row['elo_high']:.0f}")
-    lines += [_resumed_note(entry) for entry in results.get("resumed_from", [])]
+    lines += [resumed_note(entry) for entry in results.get("resumed_from", [])]
     return "\n".join(lines)
 
 
-def _resumed_note(entry):
-    """The line under the table for a resume from an unverified file."""
+def resumed_note(entry):
+    """The line under the table (and on the league's pages) for a resume from an unverified
+    file."""
     kind = {"unsigned": "an unsigned", "other key": "another key's",
             "forged": "a forged (signature not matching)"}[entry["signature"]]
     return (f"NOTE: resumed with {TRUST_OPTION} from {kind} results file: its first "

@@ -72,10 +72,47 @@ def bradley_terry_sparse(k, a, b, a_won, b_won, iterations=2000):
     return 1500.0 + 400.0 * np.log10(strength)
 
 
+#: the most numbers (resamples x matches or pairs) an array of ``bradley_terry_rows`` holds
+ROWS_BLOCK = 1 << 21
+
+
+def bradley_terry_rows(k, a, b, a_won, b_won, iterations=2000):
+    """``bradley_terry_sparse`` for many weightings of the same pairs at once: ``a_won`` and
+    ``b_won`` of shape (rows, pairs); returns the (rows, k) Elo ratings. Each row is exactly
+    (bit for bit) what ``bradley_terry_sparse`` gives for it: the same operations in the same
+    order (``np.bincount`` over the flattened rows sums each row's pairs in pair order, as it
+    does for one row), and a row stops when it converges, as the single fit does; the rows
+    still going are iterated together, which for a bootstrap's 200 small fits is about a
+    hundred times faster than one fit after another."""
+    rows = a_won.shape[0]
+    games = a_won + b_won
+
+    def by_bot(index, weights, m):  # per row, the sum of each bot's entries, in pair order
+        flat = (np.arange(m)[:, None] * k + index[None, :]).ravel()
+        return np.bincount(flat, weights.ravel(), m * k).reshape(m, k)
+
+    won = by_bot(a, a_won, rows) + by_bot(b, b_won, rows) + 0.5
+    strength = np.ones((rows, k))
+    going = np.arange(rows)
+    for _ in range(iterations):
+        if not going.size:
+            break
+        now = strength[going]
+        share = games[going] / (now[:, a] + now[:, b])
+        new = won[going] / (by_bot(a, share, going.size) + by_bot(b, share, going.size)
+                            + 1.0 / (now + 1.0))
+        converged = np.isclose(new, now, rtol=1e-12, atol=0).all(axis=1)
+        strength[going] = new
+        going = going[~converged]
+    return 1500.0 + 400.0 * np.log10(strength)
+
+
 def bradley_terry_intervals(bots, matches, samples, rng, level=0.95):
     """``{bot: (elo, low, high)}``: the Bradley-Terry fit of all matches, and the
     ``level`` percentile interval of the fits of ``samples`` bootstrap resamples drawn with
-    ``rng`` (a numpy ``Generator``)."""
+    ``rng`` (a numpy ``Generator``; one resample after another, each of n matches drawn
+    with replacement). The resamples are fitted a block at a time (``bradley_terry_rows``:
+    each fit the one ``bradley_terry_sparse`` gives alone)."""
     index = {b: i for i, b in enumerate(bots)}
     k, n = len(bots), len(matches)
     i = np.array([index[m["p1"]] for m in matches], dtype=np.int64)
@@ -94,8 +131,18 @@ def bradley_terry_intervals(bots, matches, samples, rng, level=0.95):
 
     elo = fit(np.ones(n))
     if samples and n:
-        draws = np.array([fit(np.bincount(rng.integers(0, n, n), minlength=n).astype(float))
-                          for _ in range(samples)])
+        block = max(1, ROWS_BLOCK // max(n, len(keys)))
+        draws = []
+        for start in range(0, samples, block):
+            weight = np.array([np.bincount(rng.integers(0, n, n), minlength=n).astype(float)
+                               for _ in range(min(block, samples - start))])
+            flat = (np.arange(weight.shape[0])[:, None] * len(keys) + pair[None, :]).ravel()
+            a_won = np.bincount(flat, (weight * a_share).ravel(), weight.shape[0] * len(keys))
+            b_won = np.bincount(flat, (weight * (1.0 - a_share)).ravel(),
+                                weight.shape[0] * len(keys))
+            draws.append(bradley_terry_rows(k, a, b, a_won.reshape(-1, len(keys)),
+                                            b_won.reshape(-1, len(keys))))
+        draws = np.concatenate(draws)
         tail = 100.0 * (1.0 - level) / 2.0
         low, high = np.percentile(draws, [tail, 100.0 - tail], axis=0)
     else:

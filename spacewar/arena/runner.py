@@ -12,7 +12,8 @@ class MatchRunner:
     in this process (``workers=1``), in a pool of ``workers`` local processes, or on the Dask
     cluster at ``scheduler`` (an address, or ``"local"``; default: ``DASK_SCHEDULER_ADDRESS``,
     else local). ``play(jobs, progress)`` gives every job's outcomes in job order whichever it
-    is, so the results are the same."""
+    is, so the results are the same; ``play(jobs, progress, record=True)`` brings each match's
+replay back too (``jobs.play_job``), from the worker processes or the cluster."""
 
     def __init__(self, bots, rules, workers, scheduler=None):
         from engine.cluster import scheduler_address
@@ -21,13 +22,13 @@ class MatchRunner:
         self.bots, self.rules, self.workers = list(bots), rules, workers
         self._pool = self._connection = None
 
-    def play(self, jobs, progress=lambda matches: None):
+    def play(self, jobs, progress=lambda matches: None, record=False):
         if self.address is not None:
-            return self._play_on_cluster(jobs, progress)
+            return self._play_on_cluster(jobs, progress, record)
         if self.workers == 1:
             outcomes = []
             for job in jobs:
-                outcomes.extend(play_job(job))
+                outcomes.extend(play_job(job, record))
                 progress(len(job[0]))
             return outcomes
         if self._pool is None:
@@ -35,18 +36,18 @@ class MatchRunner:
             ctx = multiprocessing.get_context("spawn")
             self._pool = concurrent.futures.ProcessPoolExecutor(
                 max_workers=self.workers, mp_context=ctx, initializer=worker_start)
-        futures = {self._pool.submit(play_job, job): len(job[0]) for job in jobs}
+        futures = {self._pool.submit(play_job, job, record): len(job[0]) for job in jobs}
         for future in concurrent.futures.as_completed(futures):
             future.result()  # surface worker errors early
             progress(futures[future])
         return [outcome for f in futures for outcome in f.result()]
 
-    def _play_on_cluster(self, jobs, progress):
+    def _play_on_cluster(self, jobs, progress, record):
         from spacewar.arena import cluster as cluster_play
 
         if self._connection is None:
             self._connection = cluster_play.connect(self.address, self.bots)
-        return cluster_play.play_jobs(self._connection, jobs, progress)
+        return cluster_play.play_jobs(self._connection, jobs, progress, record)
 
     def close(self):
         if self._pool is not None:

@@ -10,7 +10,16 @@ importing them, and each non-built-in bot is loaded only in its own confined pro
 that cannot start forfeits its matches; the table is printed all the same.
 
 Ratings: the Bradley-Terry fit of ``spacewar.arena.ratings`` (Elo scale, every result at once,
-so the order of games does not matter).
+so the order of games does not matter), with the league's 95% interval
+(``ratings.bradley_terry_intervals``): the fit repeated on ``bootstrap`` resamples of the
+matches (default 200, as a league's), drawn with replacement by a generator seeded with the
+tournament's seed (``bootstrap_rng``), so the same seed gives the same intervals. The table's
+``elo`` stays the full-matrix fit (``bradley_terry_elo``) and its order is by it; the
+interval's ends are ``elo_low`` and ``elo_high``.
+
+``replays``: a directory where each match's replay is kept (``spacewar.arena.kept_replays``:
+brought back from the worker processes or the cluster, saved under a name of its place in the
+schedule and its seed); the report is the same with or without.
 """
 import itertools
 import os
@@ -18,11 +27,12 @@ import os
 import numpy as np
 
 from spacewar.faults import printable
+from spacewar.arena import kept_replays
 # the jobs' names, public here too (a tournament's work is cut by them)
 from spacewar.arena.jobs import (batch_files_of, group_jobs, make_jobs, match_record, warm_up_game)  # noqa: F401
 from spacewar.arena.match import DEFAULT_BUDGET, DEFAULT_MAX_FAULTS
 from spacewar.rules import Rules
-from spacewar.arena.ratings import bradley_terry_elo
+from spacewar.arena.ratings import bradley_terry_elo, bradley_terry_intervals
 from spacewar.arena.runner import MatchRunner, progress_bar
 from spacewar.sandbox.limits import Limits
 
@@ -38,15 +48,30 @@ def schedule(bots, games, seed):
     return out
 
 
+#: bootstrap resamples for a tournament's rating intervals (as a league's ``--bootstrap``)
+DEFAULT_BOOTSTRAP = 200
+
+#: keeps a tournament's bootstrap draws apart from its match seeds
+BOOTSTRAP_TAG = 0xB007
+
+
+def bootstrap_rng(seed):
+    """The generator of a tournament's bootstrap resamples: from its seed alone."""
+    return np.random.default_rng(np.random.SeedSequence([int(seed), BOOTSTRAP_TAG]))
+
+
 def run_tournament(bots, games=10, seed=1, rounds=3, rules=None, workers=None, progress=True,
                    budget=DEFAULT_BUDGET, max_faults=DEFAULT_MAX_FAULTS, isolation="auto",
-                   limits=None, scheduler=None):
+                   limits=None, scheduler=None, bootstrap=DEFAULT_BOOTSTRAP, replays=None):
     """Play the round robin; return ``(report, stats)``: the table and every match result
     (plain data), and the frames played and match seconds. ``limits`` (a
     ``spacewar.sandbox.limits.Limits``) sets every budget of the bots; ``budget`` alone the per-action
     one. ``scheduler``: a Dask scheduler's address, or ``"local"`` for a LocalCluster of this
     machine (default: the ``DASK_SCHEDULER_ADDRESS`` variable, else local processes); the
-    report is the same either way (``spacewar.arena.cluster``)."""
+    report is the same either way (``spacewar.arena.cluster``). ``bootstrap``: resamples for
+    the ratings' 95% intervals (0: none, the interval is the rating). ``replays``: a
+    directory to keep every match's replay in (``spacewar.arena.kept_replays``; checked and
+    made before any match is played); the report is the same with or without."""
     bots = list(bots)
     if len(bots) < 2:
         raise ValueError(f"a tournament needs at least two bots, got {bots!r}")
@@ -64,30 +89,40 @@ def run_tournament(bots, games=10, seed=1, rounds=3, rules=None, workers=None, p
     if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
         raise ValueError(f"workers must be an int >= 1, got {workers!r}")
     limits = Limits(budget=budget) if limits is None else limits
-    jobs = make_jobs(schedule(bots, games, seed), rounds, rules, limits, max_faults, isolation,
-                     batch_files_of(bots))
+    if isinstance(bootstrap, bool) or not isinstance(bootstrap, int) or bootstrap < 0:
+        raise ValueError(f"bootstrap must be an int >= 0, got {bootstrap!r}")
+    planned = schedule(bots, games, seed)
+    names = kept_replays.tournament_names(planned)
+    if replays is not None:
+        replays = kept_replays.prepare(replays)
+        kept_replays.check_paths(replays, names)
+    jobs = make_jobs(planned, rounds, rules, limits, max_faults, isolation, batch_files_of(bots))
     bar = progress_bar(sum(len(job[0]) for job in jobs), progress)
     try:
         with MatchRunner(bots, rules, workers, scheduler) as runner:
-            outcomes = runner.play(jobs, bar.update)
+            outcomes = (runner.play(jobs, bar.update) if replays is None else
+                        runner.play(jobs, bar.update, record=True))
     finally:
         bar.close()
-    return _report(bots, games, seed, rounds, rules, outcomes)
+    if replays is not None:
+        kept_replays.save_all(replays, names, [replay for _, _, replay in outcomes])
+    return _report(bots, games, seed, rounds, rules, outcomes, bootstrap)
 
 
-def _report(bots, games, seed, rounds, rules, outcomes):
-    matches = [r for r, _ in outcomes]
+def _report(bots, games, seed, rounds, rules, outcomes, bootstrap=DEFAULT_BOOTSTRAP):
+    matches = [outcome[0] for outcome in outcomes]
     frames = sum(r["steps"] for r in matches)
-    wall = sum(t["wall_seconds"] for _, t in outcomes)
-    table = _table(bots, matches)
+    wall = sum(outcome[1]["wall_seconds"] for outcome in outcomes)
+    records = [match_record(r) for r in matches]
+    table = _table(bots, matches, records, bootstrap, seed)
     return {
         "bots": bots, "games_per_pairing": games, "seed": int(seed), "rounds": int(rounds),
-        "rules": rules.to_dict(), "table": table,
-        "matches": [match_record(r) for r in matches],
+        "rules": rules.to_dict(), "bootstrap": int(bootstrap), "table": table,
+        "matches": records,
     }, {"frames": frames, "match_seconds": wall}
 
 
-def _table(bots, matches):
+def _table(bots, matches, records, bootstrap, seed):
     rows = {b: {"bot": b, "played": 0, "wins": 0, "draws": 0, "losses": 0, "points_for": 0,
                 "points_against": 0, "faults": 0, "forfeits": 0} for b in bots}
     results = []
@@ -109,8 +144,10 @@ def _table(bots, matches):
         outcome = 0.5 if r["winner_seat"] is None else (1.0 if r["winner_seat"] == 0 else 0.0)
         results.append((p1, p2, outcome))
     elo = bradley_terry_elo(bots, results)
+    intervals = bradley_terry_intervals(bots, records, bootstrap, bootstrap_rng(seed))
     for b in bots:
-        rows[b]["elo"] = round(elo[b], 1)
+        _, low, high = intervals[b]
+        rows[b].update(elo=round(elo[b], 1), elo_low=round(low, 1), elo_high=round(high, 1))
     return sorted(rows.values(), key=lambda row: (-row["elo"], row["bot"]))
 
 

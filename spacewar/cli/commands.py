@@ -90,16 +90,42 @@ def _check_policy_files(specs):
                 raise BotLoadError(str(exc)) from None
 
 
+def _pages_and_replays(args):
+    """``(pages directory or None, replays directory or None)`` of ``--html`` and
+    ``--replays``, the pages' directory checked before any match is played; with pages and
+    no ``--replays`` the replays are kept in the pages' ``replays`` directory."""
+    if args.html is None:
+        return None, args.replays
+    from spacewar.view.league_pages import check_pages_dir, default_replays
+
+    pages = check_pages_dir(args.html)
+    return pages, default_replays(pages) if args.replays is None else args.replays
+
+
+def _write_pages(args, results, pages, replays):
+    from spacewar.view.league_pages import write_pages
+
+    summary = write_pages(pages, results, replays)
+    without = summary["replays_missing"] + summary["replays_refused"]
+    notes = (f"; {without} matches without their replay" if without else "") + (
+        f"; {summary['player_refused']} replays too long for a player page"
+        if summary["player_refused"] else "")
+    print(f"wrote {summary['index']}: {summary['bot_pages']} bot pages, "
+          f"{summary['match_pages']} match pages, {summary['bytes'] / 1e6:.1f} MB in "
+          f"{summary['seconds']:.1f} s{notes}", file=sys.stderr if args.json else sys.stdout)
+
+
 def _cmd_tournament(args):
     from spacewar.arena.tournament import format_table, run_tournament
 
     bots = [b.strip() for b in args.bots.split(",") if b.strip()]
     _check_policy_files(bots)
+    pages, replays = _pages_and_replays(args)
     report, stats = run_tournament(
         bots, games=args.games, seed=args.seed, rounds=args.rounds, rules=rules_from(args),
         workers=args.workers, progress=not args.no_progress and not args.json,
         limits=limits_from(args), max_faults=args.max_faults, isolation=args.isolation,
-        scheduler=args.scheduler)
+        scheduler=args.scheduler, bootstrap=args.bootstrap, replays=replays)
     if args.json:
         print(json.dumps(report, sort_keys=True, indent=2))
     else:
@@ -109,6 +135,8 @@ def _cmd_tournament(args):
         print(format_table(report))
         print(f"{stats['frames']} frames played; {stats['frames'] / max(stats['match_seconds'], 1e-9):.0f} "
               "frames/s per worker with bots")
+    if pages is not None:
+        _write_pages(args, report, pages, replays)
     return 0
 
 
@@ -126,6 +154,7 @@ def _cmd_league(args):
     else:
         bots = [b.strip() for b in args.bots.split(",") if b.strip()]
     _check_policy_files(bots)
+    pages, replays = _pages_and_replays(args)
 
     def report_round(results):
         if not args.json and not args.no_progress:
@@ -139,7 +168,8 @@ def _cmd_league(args):
         match_rounds=args.match_rounds, rules=rules_from(args), workers=args.workers,
         progress=not args.no_progress and not args.json, limits=limits_from(args),
         max_faults=args.max_faults, isolation=args.isolation, scheduler=args.scheduler,
-        bootstrap=args.bootstrap, on_round=report_round, trust_results=args.trust_results)
+        bootstrap=args.bootstrap, on_round=report_round, trust_results=args.trust_results,
+        replays=replays)
     if args.json:
         print(json.dumps(results, sort_keys=True, indent=1))
     else:
@@ -148,6 +178,8 @@ def _cmd_league(args):
               f"{matches} matches of {args.match_rounds} rounds, seed {args.seed}; "
               f"results in {args.out}")
         print(format_standings(results))
+    if pages is not None:
+        _write_pages(args, results, pages, replays)
     return 0
 
 

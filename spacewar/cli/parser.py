@@ -64,6 +64,18 @@ def add_replay_command(sub):
                    metavar="PIXELS", help="side of the square window (--view)")
 
 
+def add_pages_options(p):
+    """``--html DIR`` and ``--replays DIR`` of ``tournament`` and ``league``."""
+    p.add_argument("--html", metavar="DIR", default=None,
+                   help="write the standings, head-to-head matrix, a page a bot and a page a "
+                        "match (its player) into DIR, made if missing and checked before any "
+                        "match; the replays go to DIR/replays unless --replays is given")
+    p.add_argument("--replays", metavar="DIR", default=None,
+                   help="keep every match's replay in DIR (made if missing, checked before any "
+                        "match): match-00001-seed-S.json (tournament), "
+                        "round-001-match-0001-seed-S.json (league)")
+
+
 def build_parser():
     parser = argparse.ArgumentParser(
         prog="spacewar", description="Spacewar! (1962) on an N-body engine, for bots.")
@@ -97,6 +109,10 @@ def build_parser():
                    help="run the matches on a Dask cluster: its scheduler's address, or 'local' "
                         "for a LocalCluster of this machine (default: $DASK_SCHEDULER_ADDRESS, "
                         "else local processes); needs the [cluster] extra")
+    t.add_argument("--bootstrap", type=non_negative_int, default=200,
+                   help="bootstrap resamples of the matches for the ratings' 95%% intervals "
+                        "(seeded by --seed; 0: none)")
+    add_pages_options(t)
     add_rules_options(t)
     add_fault_options(t)
 
@@ -129,6 +145,7 @@ def build_parser():
                     help="resume a results file that is not verified by your signing key "
                          "(unsigned, another organizer's, or edited); its records are still "
                          "checked, and the results and the table say it was resumed so")
+    add_pages_options(lg)
     add_rules_options(lg)
     add_fault_options(lg)
 
