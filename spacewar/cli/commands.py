@@ -105,7 +105,7 @@ def _pages_and_replays(args):
 def _write_pages(args, results, pages, replays):
     from spacewar.view.league_pages import write_pages
 
-    summary = write_pages(pages, results, replays)
+    summary = write_pages(pages, results, replays, workers=getattr(args, "workers", None))
     without = summary["replays_missing"] + summary["replays_refused"]
     notes = (f"; {without} matches without their replay" if without else "") + (
         f"; {summary['player_refused']} replays too long for a player page"

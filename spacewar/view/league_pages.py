@@ -320,12 +320,13 @@ def _link(path, directory):
     return quote(relative.replace(os.sep, "/"))
 
 
-def _replays(directory, model, replays, writer, summary):
+def _replays(directory, model, replays, writer, summary, workers=1):
     """``({match name: (player page link, replay link)}, {bot: [first faults]})``: each kept
-    replay that is its match's, made into a player page when ``writer``."""
+    replay that is its match's, made into a player page when ``writer`` (on ``workers``
+    processes: a page re-simulates its match, the pages are independent)."""
     from spacewar.replay import ReplayError, load
 
-    links, faults = {}, {}
+    links, faults, pages = {}, {}, []
     if replays is None:
         return links, faults
     for m in model["matches"]:
@@ -341,19 +342,11 @@ def _replays(directory, model, replays, writer, summary):
         if not _is_this_match(replay, m):
             summary["replays_refused"] += 1
             continue
-        page_link = None
         if writer is not None:
             os.makedirs(os.path.join(directory, MATCHES_DIR), exist_ok=True)
-            out = os.path.join(directory, MATCHES_DIR, m["name"] + ".html")
-            try:
-                writer(replay, out)
-            except ReplayError:  # one the player refuses (too long to hold): no page
-                summary["player_refused"] += 1
-            else:
-                summary["match_pages"] += 1
-                summary["bytes"] += os.path.getsize(out)
-                page_link = f"{MATCHES_DIR}/{m['name']}.html"
-        links[m["name"]] = (page_link, _link(path, directory))
+            pages.append((m["name"], path, os.path.join(directory, MATCHES_DIR,
+                                                        m["name"] + ".html")))
+        links[m["name"]] = (None, _link(path, directory))
         for seat, bot in enumerate((m["p1"], m["p2"])):
             examples = replay["result"]["faults"][seat].get("examples") or []
             if m["faults"][seat] and examples:
@@ -361,7 +354,48 @@ def _replays(directory, model, replays, writer, summary):
                     {"number": m["number"], "round": m["round"], "total": m["faults"][seat],
                      "frame": examples[0]["frame"], "kind": examples[0]["kind"],
                      "message": examples[0]["message"]})
+    for (name, _, out), written in zip(pages, _player_pages(pages, writer, workers)):
+        if written is None:  # one the player refuses (too long to hold): no page
+            summary["player_refused"] += 1
+            continue
+        summary["match_pages"] += 1
+        summary["bytes"] += written
+        links[name] = (f"{MATCHES_DIR}/{name}.html", links[name][1])
     return links, faults
+
+
+def _player_pages(pages, writer, workers):
+    """The bytes of each player page written (None: refused), in the order of ``pages``
+    (``(name, replay path, page path)``); in a pool of ``workers`` processes when more than
+    one and more than one page."""
+    from spacewar.view.player_page import write_player
+
+    jobs = [(path, out) for _, path, out in pages]
+    # another process writes with the real player only: any other writer (a test's) here
+    if workers <= 1 or len(jobs) <= 1 or writer is not write_player:
+        return [_one_player_page(job, writer) for job in jobs]
+    import concurrent.futures
+    import multiprocessing
+
+    with concurrent.futures.ProcessPoolExecutor(
+            max_workers=min(workers, len(jobs)),
+            mp_context=multiprocessing.get_context("spawn")) as pool:
+        chunk = max(1, len(jobs) // (8 * workers))
+        return list(pool.map(_one_player_page, jobs, chunksize=chunk))
+
+
+def _one_player_page(job, writer=None):
+    """Write one player page (``job``: replay path, page path); its bytes, or None if the
+    player refuses the replay."""
+    from spacewar.replay import ReplayError
+
+    writer = player_writer() if writer is None else writer
+    replay_path, out = job
+    try:
+        writer(replay_path, out)
+    except ReplayError:
+        return None
+    return os.path.getsize(out)
 
 
 def _data_text(value):
@@ -386,14 +420,15 @@ def _clean(value):
 
 
 # -- the pages --------------------------------------------------------------------------------
-def write_pages(directory, results, replays=None, player=True):
+def write_pages(directory, results, replays=None, player=True, workers=None):
     """Write the pages of ``results`` (a tournament's report or a league's results) into
     ``directory`` (made if missing), linking each match to its replay in ``replays`` (a
     directory, or None) and to its player page, written when ``player`` and the player
     module is there. Returns a summary: ``index`` (its path), ``bot_pages``,
     ``match_pages``, ``replays_missing``, ``replays_refused`` (unreadable, or another
     match's), ``player_refused`` (replays the player cannot hold: linked, with no page),
-    ``bytes`` (of every page written) and ``seconds``."""
+    ``bytes`` (of every page written) and ``seconds``. ``workers``: processes writing the
+    player pages (default: one per core)."""
     start = time.perf_counter()
     directory = check_pages_dir(directory)
     model = run_model(results)
@@ -402,7 +437,8 @@ def write_pages(directory, results, replays=None, player=True):
                "match_pages": 0, "replays_missing": 0, "replays_refused": 0,
                "player_refused": 0, "bytes": 0}
     os.makedirs(os.path.join(directory, BOTS_DIR), exist_ok=True)
-    links, faults = _replays(directory, model, replays, writer, summary)
+    workers = (os.cpu_count() or 1) if workers is None else int(workers)
+    links, faults = _replays(directory, model, replays, writer, summary, workers)
     bots = model["bots"]
     pages = {b: f"{BOTS_DIR}/{bot_page(i)}" for i, b in enumerate(bots)}
     record = head_to_head(model["matches"])

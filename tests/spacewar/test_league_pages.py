@@ -650,7 +650,7 @@ def test_match_pages_are_written_and_linked_only_when_the_player_is_there(tmp_pa
     written = []
 
     def player(replay, out_path):  # stands for spacewar.view.player_page.write_player
-        written.append(replay["seed"])
+        written.append(load(replay)["seed"])  # given the kept replay's path
         with open(out_path, "w") as f:
             f.write("<!DOCTYPE html><title>player</title>\n")
 
