@@ -675,3 +675,16 @@ def test_a_large_run_has_no_matrix_but_every_bot_its_row(tmp_path, monkeypatch):
     assert "4 bots" in index.root.find("p", "note").text()
     bot_page = Page(tmp_path / "pages" / "bots" / "bot-001.html")
     assert len(bot_page.root.find("table", "h2h").find("tbody").find_all("tr")) == 3
+
+
+def test_player_pages_written_by_several_processes_are_the_same_bytes(tmp_path):
+    report, _ = run_tournament(["idle", "random", "chaser"], workers=1,
+                               replays=tmp_path / "kept", **QUICK)
+    one = league_pages.write_pages(tmp_path / "one", report, tmp_path / "kept", workers=1)
+    two = league_pages.write_pages(tmp_path / "two", report, tmp_path / "kept", workers=2)
+    assert one["match_pages"] == two["match_pages"] == len(report["matches"]) > 1
+    files = sorted(p.relative_to(tmp_path / "one") for p in (tmp_path / "one").rglob("*.html"))
+    assert files == sorted(p.relative_to(tmp_path / "two")
+                           for p in (tmp_path / "two").rglob("*.html"))
+    for name in files:
+        assert (tmp_path / "one" / name).read_bytes() == (tmp_path / "two" / name).read_bytes()
