@@ -29,7 +29,7 @@ KINDS = {
     "png": ("png",),
     "markdown": ("text",),
     "text": ("text",),
-    "html": ("text",),
+    "html": ("html",),
 }
 
 _GIF = (b"GIF87a", b"GIF89a")
@@ -111,9 +111,11 @@ def _fsync_directory(directory):
 
 
 def file_kind(path):
-    """What an existing file holds: "empty", "gif", "png", "replay", "json", "text", "binary".
+    """What an existing file holds: "empty", "gif", "png", "replay", "json", "html", "text",
+    "binary".
 
-    Only reads the file; "replay" is a JSON object whose ``format`` is ``"spacewar-replay"``.
+    Only reads the file; "replay" is a JSON object whose ``format`` is ``"spacewar-replay"``;
+    "html" is text that starts (after white space) with ``<!DOCTYPE html`` or ``<html``.
     """
     with open(path, "rb") as f:
         head = f.read(_SNIFF_LIMIT + 1)
@@ -137,6 +139,8 @@ def file_kind(path):
         if isinstance(value, dict) and value.get("format") == "spacewar-replay":
             return "replay"
         return "json"
+    if head.lstrip()[:14].lower().startswith((b"<!doctype html", b"<html")):
+        return "html"
     return "text"
 
 
@@ -214,7 +218,7 @@ def check_output_path(path, kind=None):
 
 
 _DESCRIBE = {"gif": "a GIF image", "png": "a PNG image", "replay": "a spacewar replay",
-             "json": "JSON", "text": "text", "binary": "binary data", "empty": "nothing"}
+             "json": "JSON", "html": "an HTML page", "text": "text", "binary": "binary data", "empty": "nothing"}
 
 
 def check_output_dir(path):

@@ -65,9 +65,16 @@ def display_name(name, limit=NAME_CHARACTERS):
     characters (an ellipsis marks the cut), and isolated with U+2068 ... U+2069 (Unicode
     Bidirectional Algorithm, UAX #9, "isolates"), so that right-to-left letters in it cannot
     reorder the score or the other name beside it."""
-    shown = visible(name)
-    if len(shown) > limit:
-        shown = shown[:limit - 1] + "\u2026"
+    pieces = [visible(c) for c in str(name)]  # an escape stays whole: a name is cut between
+    if sum(map(len, pieces)) > limit:
+        kept, used = [], 0
+        for piece in pieces:
+            if used + len(piece) > limit - 1:
+                break
+            kept.append(piece)
+            used += len(piece)
+        pieces = kept + ["\u2026"]
+    shown = "".join(pieces)
     return FIRST_STRONG_ISOLATE + shown + POP_DIRECTORY_ISOLATE
 
 

@@ -47,7 +47,8 @@ from engine.atomic import check_output_dir
 from spacewar.arena import kept_replays
 from spacewar.arena.ratings import match_outcome
 from spacewar.faults import printable
-from spacewar.view.html_page import check_page_path, package_text, page, text, write_page
+from spacewar.view.html_page import (check_page_path, package_text, page, text, visible,
+                                     write_page)
 
 #: above this many bots the index has no matrix (each bot's page has its row of it)
 MATRIX_MAX_BOTS = 200
@@ -154,7 +155,7 @@ def head_to_head(matches):
 def _shown(value):
     """A stranger's string as page text: control and format characters made visible, then
     HTML-escaped."""
-    return text(printable(str(value)))
+    return text(visible(value))
 
 
 def _name(name, href=None):
@@ -368,11 +369,14 @@ def _player_pages(pages, writer, workers):
     """The bytes of each player page written (None: refused), in the order of ``pages``
     (``(name, replay path, page path)``); in a pool of ``workers`` processes when more than
     one and more than one page."""
-    from spacewar.view.player_page import write_player
-
     jobs = [(path, out) for _, path, out in pages]
-    # another process writes with the real player only: any other writer (a test's) here
-    if workers <= 1 or len(jobs) <= 1 or writer is not write_player:
+    if not jobs:
+        return []
+    try:  # another process writes with the real player only: any other writer (a test's) here
+        from spacewar.view.player_page import write_player
+    except ImportError:
+        write_player = None
+    if workers <= 1 or len(jobs) <= 1 or write_player is None or writer is not write_player:
         return [_one_player_page(job, writer) for job in jobs]
     import concurrent.futures
     import multiprocessing

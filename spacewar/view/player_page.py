@@ -16,7 +16,7 @@ pixel of a ``SIZE`` x ``SIZE`` scene (1/8 of a pixel of 720), colours and string
 indices into small tables, the fixed star field is sent once, and the frames' JSON is
 compressed with zlib (deflate) and base64-encoded into the page, where the browser's own
 ``DecompressionStream("deflate")`` unpacks it. Measured: a 5-round match of 1,786 frames
-(chaser against sniper) is a 262 kB page, about 147 bytes a frame.
+(chaser against sniper) is a 266 kB page, about 149 bytes a frame.
 
 **What the page shows besides the canvas**: play and pause, speeds 1/8x to 8x, single frames
 back and forward, a scrub bar to any frame with the round boundaries marked, the bots' names,
@@ -301,8 +301,8 @@ def write_player(replay, out_path, size=SIZE):
     replay = read_replay(replay)
     document = page_html(replay, size=size)
     html_page.write_page(out_path, document)
-    encoded = document.encode(html_page.ENCODING)
-    return {"path": out_path, "frames": int(replay["frames"]) + 1, "bytes": len(encoded),
+    return {"path": out_path, "frames": int(replay["frames"]) + 1,
+            "bytes": os.path.getsize(out_path),
             "signature": _status(replay)}
 
 
@@ -318,14 +318,17 @@ class Player:
 
         from spacewar import play_match
         from spacewar.view.player_page import Player
-        result, replay, timing = play_match("chaser", "sniper", seed=7, rounds=3)
+        result, replay, timing = play_match("chaser", "sniper", seed=7, rounds=3, record=True)
         Player(replay)                     # the last line of a notebook cell: the player
 
     ``replay``: a replay dict, a replay file's path, or ``play_match``'s ``(result, replay,
     timing)``. ``width``: the frame's width in the notebook, pixels."""
 
     def __init__(self, replay, width=560):
-        if isinstance(replay, tuple) and len(replay) == 3 and isinstance(replay[1], dict):
+        if isinstance(replay, tuple) and len(replay) == 3 and isinstance(replay[0], dict):
+            if replay[1] is None:
+                raise ValueError("this match was played without its replay: play it with "
+                                 "play_match(..., record=True)")
             replay = replay[1]  # play_match's (result, replay, timing)
         if isinstance(width, bool) or not isinstance(width, int) or not 160 <= width <= 4096:
             raise ValueError(f"width must be an int in [160, 4096] pixels, got {width!r}")

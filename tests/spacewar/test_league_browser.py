@@ -59,16 +59,20 @@ def test_the_table_and_the_matrix_show_the_results_in_the_legend_s_colours(open_
     grid = rows(page, "table.matrix tbody tr")
     colours = page.evaluate("""[...document.querySelectorAll('table.matrix tbody tr')].map(
         tr => [...tr.querySelectorAll('td')].map(td => getComputedStyle(td).backgroundColor))""")
-    for a, cells, paint in zip(order, grid, colours, strict=True):
-        for b, text, colour in zip(order, cells[1:], paint):
-            wins, draws, losses, _, _ = record_of(report["matches"], a, b)
-            if a != b:
-                assert text == f"{wins}-{draws}-{losses}"
-                if losses == wins + draws == 0 or wins == draws + losses == 0:
-                    assert colour == (H10 if wins else H0)
     legend = page.evaluate("""[...document.querySelectorAll('.legend span')].slice(1).map(
         s => getComputedStyle(s).backgroundColor)""")
     assert legend[0] == H0 and legend[10] == H10 and len(set(legend[:11])) == 11
+    coloured = 0
+    for a, cells, paint in zip(order, grid, colours, strict=True):
+        for b, text, colour in zip(order, cells[1:], paint):
+            wins, draws, losses, _, _ = record_of(report["matches"], a, b)
+            if a != b and wins + draws + losses:
+                assert text == f"{wins}-{draws}-{losses}"
+                # the legend's colour of the row bot's score share, to the nearest tenth
+                share = (wins + 0.5 * draws) / (wins + draws + losses)
+                assert colour == legend[int(share * 10 + 0.5)], (a, b, text)
+                coloured += 1
+    assert coloured == len(order) * (len(order) - 1)  # a round robin: every pair met
     # the filter: a name's words keep its matches only, and the count says so
     page.fill("#match-filter", "chaser")
     visible = page.evaluate("""[...document.querySelectorAll('#match-rows tr')]

@@ -688,3 +688,16 @@ def test_player_pages_written_by_several_processes_are_the_same_bytes(tmp_path):
                            for p in (tmp_path / "two").rglob("*.html"))
     for name in files:
         assert (tmp_path / "one" / name).read_bytes() == (tmp_path / "two" / name).read_bytes()
+
+
+def test_the_pages_are_written_without_the_player_module(tmp_path, monkeypatch):
+    """With spacewar.view.player_page not importable at all (not only unused), the pages are
+    written, each match linked to its replay and to no player page."""
+    import sys
+
+    report, _ = run_tournament(["idle", "random"], workers=1, replays=tmp_path / "kept",
+                               **QUICK)
+    monkeypatch.setitem(sys.modules, "spacewar.view.player_page", None)
+    summary = league_pages.write_pages(tmp_path / "pages", report, tmp_path / "kept")
+    assert summary["match_pages"] == 0 and summary["replays_missing"] == 0
+    assert not (tmp_path / "pages" / "matches").exists()

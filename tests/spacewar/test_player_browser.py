@@ -229,24 +229,27 @@ HOSTILE = ['"><img src=x onerror="window.__owned=1">', "</script><script>window.
            "</script>", "\u202emoc.evil\u202c <b>bold</b>", "y" * 3000]
 
 
-def test_hostile_names_are_shown_as_text(open_page, recorded, tmp_path):
-    replay = dict(recorded["replay"], bots=HOSTILE[:2])
-    replay["result"] = dict(replay["result"], bots=HOSTILE[:2])
+@pytest.mark.parametrize("pair", [HOSTILE[:2], HOSTILE[2:]])
+def test_hostile_names_are_shown_as_text(open_page, recorded, tmp_path, pair):
+    replay = dict(recorded["replay"], bots=list(pair))
+    replay["result"] = dict(replay["result"], bots=list(pair))
     replay.pop(replay_io.DIGEST_FIELD)
     replay.pop(replay_io.SIGNATURE_FIELD)
     player_page.write_player(replay, tmp_path / "hostile.html")
     visit = opened(open_page, tmp_path / "hostile.html")
     page = visit.page
     visit.assert_quiet()
-    shown = [display_name(n) for n in HOSTILE[:2]]
+    shown = [display_name(n) for n in pair]
     assert page.text_content("#title") == f"{shown[0]} vs {shown[1]}"
-    assert page.get_attribute("#title", "title") == f"{visible(HOSTILE[0])} vs {visible(HOSTILE[1])}"
+    full = [visible(n)[:player_page.FULL_NAME_CHARACTERS] for n in pair]
+    assert page.get_attribute("#title", "title") == f"{full[0]} vs {full[1]}"
     assert page.evaluate("window.__owned") is None
     assert page.evaluate("document.querySelectorAll('img, b').length") == 0
     assert page.evaluate("document.scripts.length") == 2  # its data block and its code
     assert page.text_content("#signature").startswith("replay unsigned")
     texts = [d["text"] for d in page.evaluate("spacewarPlayer.drawn()") if d["kind"] == "text"]
     assert any(shown[0] in t for t in texts)  # on the canvas: drawn text, not markup
+    assert "\u202e" not in page.text_content("body")  # an override is shown escaped
 
 
 def test_the_policy_refuses_a_script_that_is_not_the_pages_own(open_page, recorded):

@@ -192,7 +192,9 @@ def test_a_name_cannot_reorder_hide_or_push_away_the_score(match):
     first, second = data["names"]
     assert first == "\u2068" + rtl + "\u2069"  # isolated: it cannot reorder what is beside it
     assert second.startswith("\u2068EVIL  3\\u2800") and second.endswith("\u2026\u2069")
-    assert len(second) == html_page.NAME_CHARACTERS + 2
+    assert len(second) <= html_page.NAME_CHARACTERS + 2
+    cut = html_page.display_name("a" * 46 + "\x07" + "b" * 10)
+    assert cut == "\u2068" + "a" * 46 + "\u2026\u2069"  # cut between escapes, not inside one
     assert "\u2800" not in json.dumps(data, ensure_ascii=False)
 
 
@@ -241,7 +243,8 @@ def test_the_notebook_player_is_the_same_page_in_a_sandboxed_frame(match):
     ((tag, attrs),) = frame.elements
     assert tag == "iframe" and attrs["sandbox"] == "allow-scripts"  # no same-origin
     assert attrs["srcdoc"] == player.html() == player_page.page_html(replay)
-    assert replay_io.load  # spacewar.replay.load still returns a plain replay dict
+    with pytest.raises(ValueError, match="record=True"):
+        Player((result, None, {}))  # play_match without its replay
     with pytest.raises(ValueError, match="width"):
         Player(replay, width=10)
     with pytest.raises(TypeError, match="replay must be"):
@@ -261,6 +264,11 @@ def test_the_command_writes_the_page_and_refuses_a_bad_path_first(match, tmp_pat
     assert main(["replay", str(path), "--html", str(path)]) == 2
     assert path.read_bytes() == before
     assert main(["replay", str(path), "--html", str(tmp_path / "no" / "x.html")]) == 2
+    source = tmp_path / "bot.py"  # any other text file, a bot's source say: not a page
+    source.write_text("class Bot:\n    pass\n")
+    assert main(["replay", str(path), "--html", str(source)]) == 2
+    assert source.read_text() == "class Bot:\n    pass\n"
+    assert main(["replay", str(path), "--html", str(out)]) == 0  # a page: replaced
     assert "error" in capsys.readouterr().err
 
 
