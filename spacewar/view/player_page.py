@@ -140,14 +140,15 @@ def _names(replay):
 
 
 def replayed_result(replay):
-    """``(result, mismatched fields)``: the result re-derived from the replay alone
-    (``spacewar.replay.check``: score, winner, forfeits from the recorded faults) and the
-    fields where the file's recorded result says otherwise. The page shows the re-derived
+    """``(result, mismatched fields, signature status)``: the result re-derived from the
+    replay alone (``spacewar.replay.check``: score, winner, forfeits from the recorded faults),
+    the fields where the file's recorded result says otherwise, and the signature's status
+    (``spacewar.replay.signature_status``, as the check found it). The page shows the re-derived
     one: a file can claim any result, but not make its frames play another."""
     from spacewar.replay import check
 
     _, details = check(replay)
-    return details["replayed"], sorted(details["mismatches"])
+    return details["replayed"], sorted(details["mismatches"]), details["signature"]
 
 
 def result_text(result, names):
@@ -227,14 +228,11 @@ class _Packer:
 
 def document_data(replay, size=SIZE):
     """The page's data: everything it shows, plain JSON (the frames compressed inside)."""
-    from spacewar.replay import signature_status
-
     names = shown_names(replay)
     packer = _Packer()
     _, tables, round_starts = frames(replay, size, sink=packer.add)
     packed = packer.finish()
-    status = signature_status(replay)
-    result, differs = replayed_result(replay)
+    result, differs, status = replayed_result(replay)
     starfield = [encode_primitive(p, tables) for p in starfield_primitives(size)]
     return {
         "format": "spacewar-player", "version": 1, "size": size, "quantum": QUANTUM,
@@ -254,6 +252,11 @@ def document_data(replay, size=SIZE):
 
 def page_html(replay, title=None, size=SIZE):
     """The whole player page for ``replay`` (a replay dict already read and validated)."""
+    return _page(replay, title, size)[0]
+
+
+def _page(replay, title, size):
+    """``(the page's text, its data)``."""
     data = document_data(replay, size)
     names = data["names"]
     title = title or f"Spacewar! {names[0]} vs {names[1]}"
@@ -276,9 +279,10 @@ def page_html(replay, title=None, size=SIZE):
         '1 normal speed &middot; Home End ends &middot; drag the bar to any frame; '
         'marks are round starts</p>'
         "</main>")
-    return html_page.page(title, body, scripts=[html_page.package_text("player.js")],
-                          styles=[html_page.package_text("player.css")],
-                          data={"spacewar-replay": data})
+    document = html_page.page(title, body, scripts=[html_page.package_text("player.js")],
+                              styles=[html_page.package_text("player.css")],
+                              data={"spacewar-replay": data})
+    return document, data
 
 
 def read_replay(replay):
@@ -299,17 +303,11 @@ def write_player(replay, out_path, size=SIZE):
     simulated; the page is written atomically."""
     out_path = html_page.check_page_path(out_path)
     replay = read_replay(replay)
-    document = page_html(replay, size=size)
+    document, data = _page(replay, None, size)
     html_page.write_page(out_path, document)
     return {"path": out_path, "frames": int(replay["frames"]) + 1,
             "bytes": os.path.getsize(out_path),
-            "signature": _status(replay)}
-
-
-def _status(replay):
-    from spacewar.replay import signature_status
-
-    return signature_status(replay)
+            "signature": data["signature"]}
 
 
 class Player:
@@ -344,8 +342,7 @@ class Player:
 
     def save(self, path):
         """Write the page at ``path`` (as ``spacewar replay FILE --html``); return the path."""
-        path = html_page.check_page_path(path)
-        return html_page.write_page(path, self.html())
+        return html_page.write_page(path, self.html())  # checks the path first
 
     def _repr_html_(self):
         height = int(math.ceil(self.width * 1.32)) + 40
